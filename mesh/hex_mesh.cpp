@@ -1,0 +1,71 @@
+#include "mesh/hex_mesh.hpp"
+
+#include "mesh/error.hpp"
+
+namespace hexrefine {
+
+std::string error_at(const std::string& file, int64_t line, const std::string& message) {
+  if (line <= 0) return file + ": " + message;
+  return file + ":" + std::to_string(line) + ": " + message;
+}
+
+const std::vector<int32_t>* mesh_find_attribute(const HexMesh& mesh, std::string_view name) {
+  for (const HexAttribute& a : mesh.attributes)
+    if (a.name == name) return &a.values;
+  return nullptr;
+}
+
+std::vector<int32_t>& mesh_attribute(HexMesh& mesh, std::string_view name, int32_t fill) {
+  for (HexAttribute& a : mesh.attributes)
+    if (a.name == name) {
+      a.values.resize(mesh.hexes.size(), fill);
+      return a.values;
+    }
+  mesh.attributes.push_back({std::string(name), std::vector<int32_t>(mesh.hexes.size(), fill)});
+  return mesh.attributes.back().values;
+}
+
+void mesh_validate_ids(const HexMesh& mesh, const std::string& what) {
+  const int64_t n = static_cast<int64_t>(mesh.points.size());
+  for (size_t h = 0; h < mesh.hexes.size(); ++h) {
+    const HexCell& c = mesh.hexes[h];
+    for (int i = 0; i < 8; ++i) {
+      if (c[i] < 0 || c[i] >= n)
+        throw InputError(what + ": hex " + std::to_string(h) + " refers to node " +
+                         std::to_string(c[i]) + ", expected 0.." + std::to_string(n - 1));
+      for (int j = 0; j < i; ++j)
+        if (c[j] == c[i])
+          throw InputError(what + ": hex " + std::to_string(h) + " repeats node " +
+                           std::to_string(c[i]) + " (degenerate hex)");
+    }
+  }
+  for (const HexAttribute& a : mesh.attributes)
+    if (a.values.size() != mesh.hexes.size())
+      throw InputError(what + ": attribute '" + a.name + "' has " +
+                       std::to_string(a.values.size()) + " values for " +
+                       std::to_string(mesh.hexes.size()) + " hexes");
+}
+
+Eigen::Vector3d hex_centroid(const HexMesh& mesh, int32_t h) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (int32_t v : mesh.hexes[h]) c += mesh.points[v];
+  return c / 8.0;
+}
+
+std::array<Eigen::Vector3d, 8> hex_points(const HexMesh& mesh, int32_t h) {
+  std::array<Eigen::Vector3d, 8> p;
+  for (int i = 0; i < 8; ++i) p[i] = mesh.points[mesh.hexes[h][i]];
+  return p;
+}
+
+std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box(const HexMesh& mesh) {
+  if (mesh.points.empty()) return {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  Eigen::Vector3d lo = mesh.points[0], hi = mesh.points[0];
+  for (const Eigen::Vector3d& p : mesh.points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return {lo, hi};
+}
+
+}  // namespace hexrefine

@@ -1,0 +1,47 @@
+#pragma once
+/// \file
+/// Runs the hexrefine executable from a test and captures its exit code and output.
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace hexrefine {
+
+struct CliRun {
+  int exit_code = -1;
+  std::string output;  ///< stdout and stderr together
+};
+
+/// Runs `hexrefine ARGS` (ARGS is passed to the shell as written) and returns its exit code and
+/// combined output.
+inline CliRun cli_run(const std::string& args) {
+  const std::string cmd = std::string(HEXREFINE_EXE) + " " + args + " 2>&1";
+  CliRun r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+/// A fresh empty folder under the system temp dir, unique per test name.
+inline std::filesystem::path test_temp_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("hexrefine_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+/// Path of a file in ../shared/meshes.
+inline std::string shared_mesh(const std::string& name) {
+  return std::string(HEXREFINE_SHARED_DIR) + "/meshes/" + name;
+}
+
+}  // namespace hexrefine

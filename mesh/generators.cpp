@@ -26,10 +26,13 @@ void param_require(bool ok, const char* generator, const char* name, T value, co
 }
 
 // Guards the int32 ids: more nodes than int32 can number is bad input, not an overflow.
-void count_require(int64_t count, const char* generator, const char* what) {
+// Counts are computed in double so that products of large parameters cannot overflow.
+void count_require(double count, const char* generator, const char* what) {
   if (count <= std::numeric_limits<int32_t>::max() / 2) return;
-  throw InputError(std::string(generator) + ": parameters give " + std::to_string(count) + " " +
-                   what + ", more than hexrefine's 32-bit ids can hold");
+  std::ostringstream s;
+  s << generator << ": parameters give " << count << " " << what
+    << ", more than hexrefine's 32-bit ids can hold";
+  throw InputError(s.str());
 }
 
 // Corner Jacobians relative to the product of the edge lengths must be at least this: the same
@@ -115,7 +118,7 @@ HexMesh generate_brick(const BrickParams& params) {
   param_require(params.jitter >= 0.0 && params.jitter < 0.5, gen, "jitter", params.jitter,
                 "0 <= jitter < 0.5");
   const std::array<int, 3>& d = params.dims;
-  count_require(int64_t{d[0] + 1} * (d[1] + 1) * (d[2] + 1), gen, "nodes");
+  count_require((d[0] + 1.0) * (d[1] + 1.0) * (d[2] + 1.0), gen, "nodes");
 
   HexMesh m;
   std::array<double, 3> h;
@@ -206,12 +209,10 @@ HexMesh generate_gear(const GearParams& p) {
                 "0 < tip_fraction <= 1");
   const int64_t pitch = int64_t{p.tooth_tangential} + p.gap_tangential;
   const int64_t around = pitch * p.teeth;
-  count_require(around * (p.body_radial + 1) +
-                    p.teeth * int64_t{p.tooth_tangential + 1} * p.tooth_radial * (p.layers + 1),
+  count_require((static_cast<double>(around) * (p.body_radial + 1.0) +
+                 static_cast<double>(p.teeth) * (p.tooth_tangential + 1.0) * p.tooth_radial) *
+                    (p.layers + 1.0),
                 gen, "nodes");
-  count_require(
-      (around * p.body_radial + int64_t{p.teeth} * p.tooth_tangential * p.tooth_radial) * p.layers,
-      gen, "hexes");
 
   const int32_t n = static_cast<int32_t>(around);
   const double dtheta = 2.0 * std::numbers::pi / n;
@@ -275,7 +276,9 @@ HexMesh generate_cylinder(const CylinderParams& p) {
   param_require(p.layers >= 1, gen, "layers", p.layers, ">= 1");
   param_require(p.core > 0.0 && p.core < 0.7, gen, "core", p.core, "0 < core < 0.7");
   const int64_t n64 = p.square_intervals, m64 = p.radial_intervals;
-  count_require(((n64 + 1) * (n64 + 1) + 4 * n64 * m64) * (p.layers + 1), gen, "nodes");
+  count_require(
+      (double(n64 + 1) * double(n64 + 1) + 4.0 * double(n64) * double(m64)) * (p.layers + 1.0), gen,
+      "nodes");
 
   const int n = p.square_intervals, m = p.radial_intervals;
   const double a = p.core * p.radius;
@@ -329,8 +332,9 @@ HexMesh generate_twisted_ring(const TwistedRingParams& p) {
       "section_size", p.section_size, "0 < section_size < ring_radius");
   param_require(p.around >= 8, gen, "around", p.around, ">= 8");
   param_require(p.section_intervals >= 1, gen, "section_intervals", p.section_intervals, ">= 1");
-  const int64_t per_layer64 = int64_t{p.section_intervals + 1} * (p.section_intervals + 1);
-  count_require(per_layer64 * p.around, gen, "nodes");
+  count_require((p.section_intervals + 1.0) * (p.section_intervals + 1.0) * p.around, gen, "nodes");
+  const int64_t per_layer64 =
+      (int64_t{p.section_intervals} + 1) * (int64_t{p.section_intervals} + 1);
 
   const int m = p.section_intervals, k_count = p.around;
   const int32_t per_layer = static_cast<int32_t>(per_layer64);
@@ -377,7 +381,7 @@ HexMesh generate_stepped(const SteppedParams& p) {
   param_require(std::isfinite(p.cell) && p.cell > 0.0, gen, "cell", p.cell, "> 0");
   const int64_t nx64 = p.top_width + int64_t{p.tread} * (p.steps - 1);
   const int64_t nz64 = int64_t{p.steps} * p.step_layers;
-  count_require((nx64 + 1) * (p.depth + 1) * (nz64 + 1), gen, "nodes");
+  count_require((double(nx64) + 1.0) * (p.depth + 1.0) * (double(nz64) + 1.0), gen, "nodes");
 
   // A cut of the bounding grid: cell (i, j, k) is kept if i < width of its step. Kept nodes
   // are renumbered in grid order (x fastest), hexes kept in grid order.

@@ -29,6 +29,7 @@ TEST(CliGenerate, BadUsageExitsTwoAndWritesNothing) {
       {"brick OUT --dims 2,2,2 --seed -3", "--seed"},
       {"brick OUT --dims 2,2,2 --size 1,0,1", "size LY"},
       {"brick OUT --dims 2,2,2 --bogus 1", "--bogus"},
+      {"brick OUT --dims 2147483647,2147483647,2147483647", "32-bit ids"},
       {"brick --dims 2,2,2", "output path"},
       {"gear OUT --radii 1,0.5,2", "root_radius"},
       {"cylinder OUT --intervals 0,3", "square_intervals"},

@@ -320,6 +320,18 @@ TEST(GenerateGear, SmallGearCountsAndBadParameters) {
   bad = GearParams{};
   bad.tip_fraction = 0.0;
   EXPECT_THROW(generate_gear(bad), InputError);
+  bad = GearParams{};
+  bad.teeth = 2000000000;  // too many ids: refused before any allocation
+  EXPECT_THROW(generate_gear(bad), InputError);
+  TwistedRingParams ring;
+  ring.section_intervals = 2147483647;
+  EXPECT_THROW(generate_twisted_ring(ring), InputError);
+  SteppedParams stepped;
+  stepped.depth = 2147483647;
+  EXPECT_THROW(generate_stepped(stepped), InputError);
+  CylinderParams cylinder;
+  cylinder.square_intervals = 100000;
+  EXPECT_THROW(generate_cylinder(cylinder), InputError);
 }
 
 // --- cylinder ----------------------------------------------------------------------------

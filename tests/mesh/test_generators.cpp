@@ -6,45 +6,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <numeric>
 #include <random>
 #include <vector>
 
+#include "mesh/dual.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
 #include "mesh/topology.hpp"
 #include "tests/fixtures.hpp"
 
-#if __has_include("mesh/quality.hpp")
-#include "mesh/quality.hpp"
-#define HEXREFINE_HAVE_QUALITY 1
-#endif
-
 namespace hexrefine {
 namespace {
-
-// Minimum scaled Jacobian over all hexes.
-double mesh_min_scaled_jacobian(const HexMesh& m) {
-  double lo = 2.0;
-#ifdef HEXREFINE_HAVE_QUALITY
-  for (int32_t h = 0; h < m.hex_count(); ++h)
-    lo = std::min(lo, hex_scaled_jacobian(hex_points(m, h)));
-#else
-  // Until mesh/quality.hpp lands: min over corners of det of the three unit edge vectors.
-  for (int32_t h = 0; h < m.hex_count(); ++h) {
-    const auto p = hex_points(m, h);
-    for (int v = 0; v < 8; ++v) {
-      Eigen::Vector3d e[3];
-      for (int k = 0; k < 3; ++k) {
-        const int le = hex_vertex_edges[v][k];
-        e[k] = (p[hex_edges[le][1]] - p[hex_edges[le][0]]).normalized();
-      }
-      lo = std::min(lo, e[0].dot(e[1].cross(e[2])));
-    }
-  }
-#endif
-  return lo;
-}
 
 // Every boundary edge lies in exactly two boundary faces (a closed boundary surface); returns the
 // number of boundary edges.
@@ -64,36 +37,17 @@ int boundary_edges_closed(const HexTopology& t) {
   return edges;
 }
 
-// Private dual-sheet counter (union-find of each hex's four parallel edges); a sheet is
-// self-intersecting if one hex has two of its directions in it.
+// Sheet counts from mesh/dual.hpp.
 struct SheetCount {
   int sheets = 0;
   int self_intersecting = 0;
 };
 
 SheetCount sheets_count(const HexMesh& m, const HexTopology& t) {
-  std::vector<int32_t> parent(t.edge_count());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (int32_t h = 0; h < m.hex_count(); ++h)
-    for (int a = 0; a < 3; ++a)
-      for (int i = 1; i < 4; ++i)
-        parent[find(t.hex_edge_ids[h][hex_axis_edges[a][i]])] =
-            find(t.hex_edge_ids[h][hex_axis_edges[a][0]]);
+  const DualSheets d = dual_build(m, t);
   SheetCount out;
-  std::vector<uint8_t> self(t.edge_count(), 0);
-  for (int32_t e = 0; e < t.edge_count(); ++e) out.sheets += find(e) == e;
-  for (int32_t h = 0; h < m.hex_count(); ++h) {
-    int32_t root[3];
-    for (int a = 0; a < 3; ++a) root[a] = find(t.hex_edge_ids[h][hex_axis_edges[a][0]]);
-    for (int a = 0; a < 3; ++a)
-      for (int b = a + 1; b < 3; ++b)
-        if (root[a] == root[b]) self[root[a]] = 1;
-  }
-  for (uint8_t s : self) out.self_intersecting += s;
+  out.sheets = d.sheet_count();
+  for (const SheetInfo& s : d.sheets) out.self_intersecting += s.self_intersecting;
   return out;
 }
 

@@ -100,6 +100,9 @@ HexMesh abaqus_read(const std::string& path) {
   while (in.remaining() > 0) {
     const int64_t line_no = in.line();
     std::string_view line = trim(in.rest_of_line());
+    auto fail_line = [&](const std::string& message) {
+      throw InputError(error_at(path, line_no, message));
+    };
     if (line.empty() || line.substr(0, 2) == "**") continue;
     if (line[0] == '*') {
       saw_keyword = true;
@@ -110,21 +113,22 @@ HexMesh abaqus_read(const std::string& path) {
         mode = Mode::node;
       } else if (key == "ELEMENT") {
         const std::string type = upper(keyword_parameter(fields, "TYPE"));
-        if (type.empty()) in.fail("*ELEMENT needs TYPE=...");
+        if (type.empty()) fail_line("*ELEMENT needs TYPE=...");
         const size_t at = type.find("C3D8");
         const bool hex = (at == 0 || (at == 1 && type[0] == 'D')) &&
                          std::all_of(type.begin() + at + 4, type.end(),
                                      [](char c) { return c >= 'A' && c <= 'Z'; });
         if (!hex && type.find("3D") != std::string::npos)
-          in.fail("element type " + type +
-                  " is a volume element that is not a linear hexahedron (only C3D8 is supported)");
+          fail_line(
+              "element type " + type +
+              " is a volume element that is not a linear hexahedron (only C3D8 is supported)");
         mode = hex ? Mode::hex : Mode::other_element;
         const std::string set = keyword_parameter(fields, "ELSET");
         current_block = 0;
         if (!set.empty()) block_of_set_name(set, current_block);
       } else if (key == "ELSET") {
         const std::string name = keyword_parameter(fields, "ELSET");
-        if (name.empty()) in.fail("*ELSET needs ELSET=name");
+        if (name.empty()) fail_line("*ELSET needs ELSET=name");
         int32_t block = 0;
         if (block_of_set_name(name, block)) {
           mode = Mode::elset;

@@ -86,9 +86,11 @@ HexMesh exodus_read(const std::string& path) {
     mesh.points.resize(nodes);
     for (int64_t i = 0; i < nodes; ++i) {
       mesh.points[i] = Eigen::Vector3d(x[i], y[i], z[i]);
-      if (!mesh.points[i].allFinite())
+      // netCDF returns its fill value for data missing from a truncated file.
+      if (!mesh.points[i].allFinite() || (mesh.points[i].array() == 9.9692099683868690e+36).any())
         throw InputError(path + ": node " + std::to_string(i + 1) +
-                         " has a NaN or infinite coordinate");
+                         " has a NaN, infinite or unwritten (netCDF fill) coordinate: corrupt or "
+                         "truncated file");
     }
   }
   std::vector<int64_t> block_ids(blocks);
@@ -97,6 +99,12 @@ HexMesh exodus_read(const std::string& path) {
   std::vector<int64_t> element_map(elems);
   if (elems > 0 && ex_get_id_map(file.id, EX_ELEM_MAP, element_map.data()) < 0)
     throw InputError(path + ": cannot read the element id map");
+  for (int64_t e = 0; e < elems; ++e)
+    if (element_map[e] < 1)
+      throw InputError(path + ": element " + std::to_string(e + 1) + " has id " +
+                       std::to_string(element_map[e]) +
+                       " in the element id map, expected >= 1 "
+                       "(corrupt or truncated file)");
   std::vector<int64_t> hex_ids;
   std::vector<int32_t> block;
   int64_t first_element = 0;

@@ -4,16 +4,26 @@ namespace hexrefine {
 
 const char* template_tag_name(TemplateTag tag) {
   switch (tag) {
-    case TemplateTag::untouched: return "untouched";
-    case TemplateTag::t1_27: return "1-27";
-    case TemplateTag::t1_13: return "1-13";
-    case TemplateTag::t1_5: return "1-5";
-    case TemplateTag::t1_4: return "1-4";
-    case TemplateTag::t1_3: return "1-3";
-    case TemplateTag::t1_3_adjust1: return "1-3-adj1";
-    case TemplateTag::t1_3_adjust2: return "1-3-adj2";
-    case TemplateTag::directional: return "directional";
-    case TemplateTag::sheet: return "sheet";
+    case TemplateTag::untouched:
+      return "untouched";
+    case TemplateTag::t1_27:
+      return "1-27";
+    case TemplateTag::t1_13:
+      return "1-13";
+    case TemplateTag::t1_5:
+      return "1-5";
+    case TemplateTag::t1_4:
+      return "1-4";
+    case TemplateTag::t1_3:
+      return "1-3";
+    case TemplateTag::t1_3_adjust1:
+      return "1-3-adj1";
+    case TemplateTag::t1_3_adjust2:
+      return "1-3-adj2";
+    case TemplateTag::directional:
+      return "directional";
+    case TemplateTag::sheet:
+      return "sheet";
   }
   return "unknown";
 }

@@ -36,11 +36,11 @@ struct Targets {
 };
 
 struct RefineOptions {
-  bool ranking = true;       ///< Selective: rank directions across directional groups.
-  bool propagation = true;   ///< Selective: propagation scheme after each directional step.
-  bool ebe_only = false;     ///< Selective: element-by-element only (as Schneiders).
-  int passes = 1;            ///< Refine the region this many times.
-  bool buffer = false;       ///< Add the previous pass's transition layer to the next targets.
+  bool ranking = true;      ///< Selective: rank directions across directional groups.
+  bool propagation = true;  ///< Selective: propagation scheme after each directional step.
+  bool ebe_only = false;    ///< Selective: element-by-element only (as Schneiders).
+  int passes = 1;           ///< Refine the region this many times.
+  bool buffer = false;      ///< Add the previous pass's transition layer to the next targets.
   bool allow_inverted = false;
 };
 

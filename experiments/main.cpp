@@ -1,3 +1,5 @@
 #include "experiments/cli.hpp"
 
-int main(int argc, char** argv) { return hexrefine::cli_main(argc, argv); }
+int main(int argc, char** argv) {
+  return hexrefine::cli_main(argc, argv);
+}

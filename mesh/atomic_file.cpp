@@ -37,7 +37,8 @@ void file_write_atomically(const std::string& path,
   const std::string tmp = file_temporary_beside(path);
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw OperationError(path + ": cannot open for writing (folder missing or not writable)");
+    if (!out)
+      throw OperationError(path + ": cannot open for writing (folder missing or not writable)");
     try {
       write(out);
       out.flush();

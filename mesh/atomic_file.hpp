@@ -13,7 +13,8 @@ namespace hexrefine {
 /// Calls `write` with a binary stream on a temporary file beside `path`, then renames it to
 /// `path`. Throws OperationError naming the path if it cannot be created, written or renamed
 /// (the temporary file is removed).
-void file_write_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
+void file_write_atomically(const std::string& path,
+                           const std::function<void(std::ostream&)>& write);
 
 /// A temporary path beside `path` for writers that need a file name (e.g. the Exodus II library);
 /// pair with file_commit_temporary.

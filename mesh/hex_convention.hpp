@@ -78,12 +78,12 @@ inline constexpr int hex_faces[6][4] = {
 
 /// The four local edges of each face, edge i joining face vertices i and i+1 (mod 4).
 inline constexpr int hex_face_edges[6][4] = {
-    {8, 7, 11, 3},  // f0
-    {1, 10, 5, 9},  // f1
-    {0, 9, 4, 8},   // f2
-    {11, 6, 10, 2}, // f3
-    {3, 2, 1, 0},   // f4
-    {4, 5, 6, 7},   // f5
+    {8, 7, 11, 3},   // f0
+    {1, 10, 5, 9},   // f1
+    {0, 9, 4, 8},    // f2
+    {11, 6, 10, 2},  // f3
+    {3, 2, 1, 0},    // f4
+    {4, 5, 6, 7},    // f5
 };
 
 /// The two faces that contain each edge (lower face index first).

@@ -4,6 +4,7 @@
 /// int32 ids, and optional per-hex integer attributes carried through I/O.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <string>

@@ -11,7 +11,8 @@ namespace {
 // Counting-sort CSR of `items` keyed by key(i) in [0, key_count).
 template <class KeyOf>
 void build_csr(int32_t key_count, int64_t item_count, KeyOf key_of, std::vector<int32_t>& offsets,
-               std::vector<int32_t>& values, int per_item, const std::vector<int32_t>* item_values) {
+               std::vector<int32_t>& values, int per_item,
+               const std::vector<int32_t>* item_values) {
   offsets.assign(static_cast<size_t>(key_count) + 1, 0);
   for (int64_t i = 0; i < item_count; ++i)
     for (int k = 0; k < per_item; ++k) ++offsets[key_of(i, k) + 1];

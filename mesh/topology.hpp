@@ -56,7 +56,9 @@ inline std::span<const int32_t> edge_hexes(const HexTopology& t, int32_t e) {
           t.edge_hexes.data() + t.edge_hex_offsets[e + 1]};
 }
 
-inline bool face_is_boundary(const HexTopology& t, int32_t f) { return t.face_hexes[f][1] < 0; }
+inline bool face_is_boundary(const HexTopology& t, int32_t f) {
+  return t.face_hexes[f][1] < 0;
+}
 
 /// The hex across local face lf of hex h, or -1 on the boundary.
 inline int32_t hex_face_neighbor(const HexTopology& t, int32_t h, int lf) {

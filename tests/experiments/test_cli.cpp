@@ -8,8 +8,10 @@ namespace hexrefine {
 namespace {
 
 TEST(Cli, ParsesValuesFlagsAndPositionals) {
-  const CliArgs a = cli_parse("refine", {"in.mesh", "--select", "all", "out.vtk", "--select", "box:0,0,0,1,1,1", "--smooth"},
-                              {"--select"}, {"--smooth"});
+  const CliArgs a = cli_parse(
+      "refine",
+      {"in.mesh", "--select", "all", "out.vtk", "--select", "box:0,0,0,1,1,1", "--smooth"},
+      {"--select"}, {"--smooth"});
   ASSERT_EQ(a.positional.size(), 2u);
   EXPECT_EQ(a.positional[1], "out.vtk");
   EXPECT_EQ(a.all("--select").size(), 2u);

@@ -34,7 +34,8 @@ TEST(Topology, BrickCounts) {
   // Interior edge valence 4, interior node has 8 hexes.
   int valence4 = 0;
   for (int32_t e = 0; e < t.edge_count(); ++e) valence4 += edge_hexes(t, e).size() == 4;
-  EXPECT_EQ(valence4, (nx - 1) * (ny - 1) * nz + (nx - 1) * ny * (nz - 1) + nx * (ny - 1) * (nz - 1));
+  EXPECT_EQ(valence4,
+            (nx - 1) * (ny - 1) * nz + (nx - 1) * ny * (nz - 1) + nx * (ny - 1) * (nz - 1));
   // Every hex's faces point back to it, and neighbours are consistent.
   for (int32_t h = 0; h < m.hex_count(); ++h)
     for (int lf = 0; lf < 6; ++lf) {

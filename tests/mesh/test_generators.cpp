@@ -15,36 +15,11 @@
 #include "mesh/topology.hpp"
 #include "tests/fixtures.hpp"
 
-#if __has_include("mesh/quality.hpp")
 #include "mesh/quality.hpp"
-#define HEXREFINE_HAVE_QUALITY 1
-#endif
 
 namespace hexrefine {
 namespace {
 
-// Minimum scaled Jacobian over all hexes.
-double mesh_min_scaled_jacobian(const HexMesh& m) {
-  double lo = 2.0;
-#ifdef HEXREFINE_HAVE_QUALITY
-  for (int32_t h = 0; h < m.hex_count(); ++h)
-    lo = std::min(lo, hex_scaled_jacobian(hex_points(m, h)));
-#else
-  // Until mesh/quality.hpp lands: min over corners of det of the three unit edge vectors.
-  for (int32_t h = 0; h < m.hex_count(); ++h) {
-    const auto p = hex_points(m, h);
-    for (int v = 0; v < 8; ++v) {
-      Eigen::Vector3d e[3];
-      for (int k = 0; k < 3; ++k) {
-        const int le = hex_vertex_edges[v][k];
-        e[k] = (p[hex_edges[le][1]] - p[hex_edges[le][0]]).normalized();
-      }
-      lo = std::min(lo, e[0].dot(e[1].cross(e[2])));
-    }
-  }
-#endif
-  return lo;
-}
 
 // Every boundary edge lies in exactly two boundary faces (a closed boundary surface); returns the
 // number of boundary edges.

@@ -580,4 +580,115 @@ const HexTemplate& template_1_5() {
   return t;
 }
 
+const HexTemplate& template_1_13() {
+  // The four edges of face z=0 split: 1-9 on the bottom, 1-4 face templates on the four sides
+  // (transition nodes at z = 1/2), top face whole. Nine bottom-layer hexes over the 3x3 bottom
+  // grid (the corner ones reach the top corners, since each side's quad (A, P1, Q1, D) holds the
+  // whole vertical edge) whose tops meet at four interior nodes (i/3, j/3, t); the upper region,
+  // bounded by 14 quads, is filled by four hexes: two side hexes over the y=0 and y=1 edge-hexes
+  // (each also taking the tops of the two adjacent corner hexes), a centre hex whose top joins
+  // the x-side transition nodes, and a top hex holding the face z=1. 13 children.
+  static const HexTemplate t = template_1_13_build(template_1_13_interior_height);
+  return t;
+}
+
+HexTemplate template_1_13_build(double interior_height) {
+  {
+    TemplateBuilder b(TemplateTag::t1_13);
+    const double h = 0.5, tz = interior_height;
+    // Top node of bottom-layer grid line (i, j), i, j in 0..3.
+    auto top = [&](int i, int j) {
+      const bool ei = i == 0 || i == 3, ej = j == 0 || j == 3;
+      const double z = (ei && ej) ? 1.0 : (ei || ej) ? h : tz;
+      return b.node(i / 3.0, j / 3.0, z);
+    };
+    auto bottom = [&](int i, int j) { return b.node(i / 3.0, j / 3.0, 0); };
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i)
+        b.child({bottom(i, j), bottom(i + 1, j), bottom(i + 1, j + 1), bottom(i, j + 1), top(i, j),
+                 top(i + 1, j), top(i + 1, j + 1), top(i, j + 1)});
+    const int16_t c00 = b.node(0, 0, 1), c10 = b.node(1, 0, 1), c11 = b.node(1, 1, 1),
+                  c01 = b.node(0, 1, 1);
+    b.child({top(1, 0), top(2, 0), top(2, 1), top(1, 1), c00, c10, top(3, 1), top(0, 1)});
+    b.child({top(1, 3), top(2, 3), top(2, 2), top(1, 2), c01, c11, top(3, 2), top(0, 2)});
+    b.child(
+        {top(1, 1), top(2, 1), top(2, 2), top(1, 2), top(0, 1), top(3, 1), top(3, 2), top(0, 2)});
+    b.child({top(0, 1), top(3, 1), top(3, 2), top(0, 2), c00, c10, c11, c01});
+    return b.take();
+  }
+}
+
+namespace {
+
+// The three slabs across x of the adjusted 1-3 templates: the end slabs hold the whole faces
+// x=0 and x=1, inner sections are the quad `section` (y, z) whose corners at adjusted edges are
+// adjustment nodes (index 0 at x=1/3, 1 at x=2/3).
+HexTemplate template_adjusted_slabs(TemplateTag tag,
+                                    const std::array<std::array<double, 2>, 4>& sec,
+                                    const std::array<int, 4>& adjust_edge) {
+  TemplateBuilder b(tag);
+  auto whole = [&](double x) {
+    return std::array<int16_t, 4>{b.node(x, 0, 0), b.node(x, 1, 0), b.node(x, 1, 1),
+                                  b.node(x, 0, 1)};
+  };
+  std::array<std::array<int16_t, 4>, 2> inner;
+  for (int k = 0; k < 2; ++k) {
+    const double x = (k + 1) / 3.0;
+    for (int c = 0; c < 4; ++c)
+      inner[k][c] = adjust_edge[c] >= 0 ? b.adjustment(adjust_edge[c], k, x, sec[c][0], sec[c][1])
+                                        : b.node(x, sec[c][0], sec[c][1]);
+  }
+  b.child(whole(0), inner[0]);
+  b.child(inner[0], inner[1]);
+  b.child(inner[1], whole(1));
+  return b.take();
+}
+
+}  // namespace
+
+const HexTemplate& template_1_3_adjust1() {
+  // x-edges e0 (y0 z0), e2 (y1 z0), e4 (y0 z1) split, e6 (y1 z1) not. Faces y=0 and z=0 are 1-3
+  // faces, faces y=1 and z=1 carry 1-4 face templates whose top quads both touch e6: the
+  // adjustment (Parrish, Figure E-21) merges their transition nodes into two adjustment nodes
+  // (x, q, q) inside the hex, so the two top quads become one face shared by the neighbours
+  // across y=1 and z=1 (TemplateFaceAlias). Three slabs with section (0,0) (1,0) (q,q) (0,1).
+  static const HexTemplate t = template_adjusted_slabs(
+      TemplateTag::t1_3_adjust1,
+      {{{0, 0}, {1, 0}, {template_adjustment_depth, template_adjustment_depth}, {0, 1}}},
+      {-1, -1, 6, -1});
+  return t;
+}
+
+const HexTemplate& template_1_3_adjust2() {
+  // x-edges e0 (y0 z0) and e6 (y1 z1) split: all four side faces carry 1-4 face templates;
+  // adjustments at e2 (y1 z0: faces y=1 and z=0 merged) and at e4 (y0 z1: faces y=0 and z=1).
+  // Three slabs with section (0,0) (q,1-q) (1,1) (1-q,q).
+  const double q = template_adjustment_depth;
+  static const HexTemplate t = template_adjusted_slabs(
+      TemplateTag::t1_3_adjust2, {{{0, 0}, {q, 1 - q}, {1, 1}, {1 - q, q}}}, {-1, 2, -1, 4});
+  return t;
+}
+
+}  // namespace hexrefine
+
+namespace hexrefine {
+
+TemplateChoice template_for_mask(uint16_t mask) {
+  static const std::array<TemplateChoice, 4096> table = [] {
+    std::array<TemplateChoice, 4096> out{};
+    const HexTemplate* all[] = {&template_1_27(),       &template_1_13(), &template_1_5(),
+                                &template_1_4(),        &template_1_3(),  &template_1_3_adjust1(),
+                                &template_1_3_adjust2()};
+    for (const HexTemplate* t : all) {
+      const uint16_t canonical = template_split_edges(*t);
+      for (int s = 0; s < 48; ++s) {
+        const uint16_t m = cube_symmetry_edge_mask(cube_symmetries()[s], canonical);
+        if (!out[m].tmpl) out[m] = {t, static_cast<int8_t>(s)};
+      }
+    }
+    return out;
+  }();
+  return table[mask & 0xFFF];
+}
+
 }  // namespace hexrefine

@@ -116,6 +116,31 @@ const HexTemplate& template_1_3();
 const HexTemplate& template_1_4();
 /// 1-5: one edge split (e0); faces y=0 and z=0 carry 1-4 face templates; 5 children.
 const HexTemplate& template_1_5();
+/// 1-13: the four edges of face z=0 split (e0..e3); 13 children.
+const HexTemplate& template_1_13();
+/// 1-3 with one adjustment: e0 e2 e4 split, e6 not; adjustment nodes on e6; 3 children.
+const HexTemplate& template_1_3_adjust1();
+/// 1-3 with two adjustments: e0 e6 split; adjustment nodes on e2 and e4; 3 children.
+const HexTemplate& template_1_3_adjust2();
+
+/// 1-13 with its four interior nodes at height `interior_height` in (0, 1) (for quality scans).
+HexTemplate template_1_13_build(double interior_height);
+/// Height of the four interior nodes of 1-13. The minimum scaled Jacobian is 4/13 = 0.3077 (the
+/// thesis' L-shaped value) for every height in (0, 0.27], fixed by the corner children; above
+/// that it drops (0.5 is degenerate). 1/6 lies inside the plateau and on the sixths grid.
+inline constexpr double template_1_13_interior_height = 1.0 / 6.0;
+/// Depth q of adjustment nodes: (x, q, q) for an adjustment at edge (y1, z1). A multiple of 1/6
+/// so that sub-hexes of directional refinement keep exact reference positions.
+inline constexpr double template_adjustment_depth = 2.0 / 3.0;
+
+/// The template and symmetry for a split-edge mask (bit e = local edge e split), from a table
+/// precomputed over the seven templates and 48 symmetries; tmpl is nullptr for mask 0 and for
+/// masks no template matches (those hexes need directional refinement).
+struct TemplateChoice {
+  const HexTemplate* tmpl = nullptr;
+  int8_t symmetry = 0;
+};
+TemplateChoice template_for_mask(uint16_t mask);
 
 /// Checks a template on the unit cube: every child has positive scaled Jacobian, children fill the
 /// cube (volumes sum to 1), and no face is shared by more than two children. Returns the minimum

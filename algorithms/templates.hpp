@@ -169,8 +169,20 @@ class TemplateRefiner {
   /// Applies `tmpl` in orientation `symmetry` to `cell` and appends its children to `children`
   /// (their keys, params and axes filled in). Throws OperationError if the cell cannot be refined
   /// (inexact corners, or sub-cells nested too deep for exact positions).
+  /// `node_keys`, if given, receives the key each template node was placed under (before
+  /// aliasing), indexed like tmpl.nodes.
   void apply(const TemplateCell& cell, const HexTemplate& tmpl, int symmetry,
-             std::vector<TemplateCell>& children);
+             std::vector<TemplateCell>& children,
+             std::vector<TemplateNodeKey>* node_keys = nullptr);
+
+  /// Key of the template node `node` (with its position `local_ref` in the cell's frame, i.e.
+  /// already mapped by the symmetry) as apply() would place it; throws OperationError if the
+  /// position is not exact.
+  TemplateNodeKey key_of_template_node(const TemplateCell& cell, int symmetry,
+                                       const TemplateNode& node) const;
+
+  /// Key of every node created so far, indexed by node id - input point count.
+  const std::vector<TemplateNodeKey>& created_keys() const { return created_keys_; }
 
   /// Output points (input points first, then every node created).
   const std::vector<Eigen::Vector3d>& points() const { return points_; }
@@ -181,6 +193,7 @@ class TemplateRefiner {
   const HexMesh& mesh_;
   const HexTopology& topology_;
   std::vector<Eigen::Vector3d> points_;
+  std::vector<TemplateNodeKey> created_keys_;
   std::unordered_map<TemplateNodeKey, int32_t, TemplateNodeKeyHash> nodes_;
   std::unordered_map<TemplateNodeKey, TemplateNodeKey, TemplateNodeKeyHash> aliases_;
 };
@@ -221,7 +234,7 @@ HexTemplate template_1_13_build(double interior_height);
 inline constexpr double template_1_13_interior_height = 1.0 / 6.0;
 /// Depth q of adjustment nodes: (x, q, q) for an adjustment at edge (y1, z1). A multiple of 1/6
 /// so that sub-hexes of directional refinement keep exact reference positions.
-inline constexpr double template_adjustment_depth = 2.0 / 3.0;
+inline constexpr double template_adjustment_depth = 5.0 / 6.0;
 
 /// The template and symmetry for a split-edge mask (bit e = local edge e split), from a table
 /// precomputed over the seven templates and 48 symmetries; tmpl is nullptr for mask 0 and for

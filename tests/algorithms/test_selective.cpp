@@ -41,14 +41,20 @@ TEST(Selective, LShapedCase) {
   const RefineResult r = selective_refine(m, t, {});
   const RefinerSuiteVerdict v =
       refiner_suite_check(r.mesh, refiner_suite_box({0, 0, 0}, {10, 10, 10}));
-  for (const auto& [name, n] : r.stats.hexes_per_template)
-    std::printf("%s %ld\n", name.c_str(), long(n));
   EXPECT_TRUE(v.conformal()) << v.nonmanifold_faces << " " << v.interior_boundary_faces;
   EXPECT_EQ(v.inverted_hexes, 0);
   EXPECT_EQ(v.doublets, 0);
   EXPECT_EQ(r.mesh.hex_count(), 8060);
   EXPECT_GE(v.min_scaled_jacobian, 0.3077 - 1e-4);
-  std::printf("L min sj %.4f\n", v.min_scaled_jacobian);
+  // 190 x 27 + 160 face transitions x 13 + 10 corner hexes x 21 (directional) + 640 untouched.
+  EXPECT_EQ(r.stats.hexes_per_template.at("1-27"), 5130);
+  EXPECT_EQ(r.stats.hexes_per_template.at("1-13"), 2080);
+  EXPECT_EQ(r.stats.hexes_per_template.at("directional"), 210);
+  EXPECT_EQ(r.stats.hexes_per_template.at("untouched"), 640);
+  EXPECT_EQ(r.stats.directional_hexes, 10);
+  EXPECT_EQ(r.stats.directional_groups, 1);
+  EXPECT_EQ(r.stats.doublets_resolved, 0);
+  EXPECT_NEAR(v.min_scaled_jacobian, 0.3077, 1e-4);  // the thesis' value (Table G-1)
 }
 
 }  // namespace

@@ -1,0 +1,234 @@
+#include "algorithms/sheet.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "mesh/error.hpp"
+#include "mesh/hex_convention.hpp"
+#include "mesh/topology.hpp"
+#include "tests/fixtures.hpp"
+
+namespace hexrefine {
+namespace {
+
+uint16_t edge_bits(std::initializer_list<int> edges) {
+  uint16_t m = 0;
+  for (int e : edges) m |= static_cast<uint16_t>(1u << e);
+  return m;
+}
+
+// What a conformal, valid mesh of the box [lo, hi] satisfies, checked from its topology:
+// every face is shared by two hexes unless it lies on the box surface (a hanging node or a
+// mismatched face template leaves an interior face with one hex), the boundary faces cover the
+// box surface exactly once, no two points coincide, and every corner Jacobian is positive.
+void expect_conformal_box(const HexMesh& m, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const HexTopology t = topology_build(m);
+  ASSERT_TRUE(t.nonmanifold_faces.empty());
+  const double tol = 1e-9;
+  double area = 0;
+  int interior_open = 0;
+  for (int32_t f : topology_boundary_faces(t)) {
+    const auto& q = t.face_nodes[f];
+    bool on_plane = false;
+    for (int k = 0; k < 3 && !on_plane; ++k)
+      for (double side : {lo[k], hi[k]}) {
+        bool all = true;
+        for (int32_t v : q) all = all && std::abs(m.points[v][k] - side) < tol;
+        on_plane = on_plane || all;
+      }
+    interior_open += !on_plane;
+    const Eigen::Vector3d a = m.points[q[0]], b = m.points[q[1]], c = m.points[q[2]],
+                          d = m.points[q[3]];
+    area += 0.5 * ((b - a).cross(c - a).norm() + (c - a).cross(d - a).norm());
+  }
+  EXPECT_EQ(interior_open, 0);
+  const Eigen::Vector3d s = hi - lo;
+  EXPECT_NEAR(area, 2 * (s.x() * s.y() + s.y() * s.z() + s.z() * s.x()), 1e-6);
+  std::vector<std::array<double, 3>> pts;
+  for (const auto& p : m.points) pts.push_back({p.x(), p.y(), p.z()});
+  std::sort(pts.begin(), pts.end());
+  int duplicates = 0;
+  for (size_t i = 1; i < pts.size(); ++i) {
+    bool same = true;
+    for (int k = 0; k < 3; ++k) same = same && std::abs(pts[i][k] - pts[i - 1][k]) < tol;
+    duplicates += same;
+  }
+  EXPECT_EQ(duplicates, 0);
+  // Every point is used (no orphan node left by a template).
+  std::vector<uint8_t> used(m.points.size(), 0);
+  for (const auto& c : m.hexes)
+    for (int32_t v : c) used[v] = 1;
+  EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0);
+  int inverted = 0;
+  for (const auto& c : m.hexes)
+    for (int v = 0; v < 8; ++v) {
+      Eigen::Vector3d d[3];
+      for (int k = 0; k < 3; ++k) {
+        const int e = hex_vertex_edges[v][k];
+        const int w = hex_edges[e][0] == v ? hex_edges[e][1] : hex_edges[e][0];
+        d[k] = (m.points[c[w]] - m.points[c[v]]) * (hex_corner[w][k] > hex_corner[v][k] ? 1 : -1);
+      }
+      inverted += d[0].cross(d[1]).dot(d[2]) <= 0;
+    }
+  EXPECT_EQ(inverted, 0);
+}
+
+void expect_conformal_brick(const HexMesh& m, int nx, int ny, int nz) {
+  expect_conformal_box(m, Eigen::Vector3d::Zero(), Eigen::Vector3d(nx, ny, nz));
+}
+
+Targets all_hexes(const HexMesh& m) {
+  Targets t;
+  for (int32_t h = 0; h < m.hex_count(); ++h) t.hexes.push_back(h);
+  return t;
+}
+
+// The thesis' L-shaped case: hexes on the x-min and z-min surfaces of a 10x10x10 brick.
+Targets l_shaped_targets(int n) {
+  Targets t;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        if (i == 0 || k == 0) t.hexes.push_back(fixture_brick_hex(n, n, i, j, k));
+  return t;
+}
+
+TEST(HexAxisPattern, DirectionalTemplatesByParallelSplitEdges) {
+  EXPECT_EQ(hex_axis_pattern(0, 0), SheetPattern::none);
+  EXPECT_EQ(hex_axis_pattern(edge_bits({1, 3, 8}), 0), SheetPattern::none);  // other axes only
+  EXPECT_EQ(hex_axis_pattern(edge_bits({0}), 0), SheetPattern::one_to_five);
+  EXPECT_EQ(hex_axis_pattern(edge_bits({0, 2}), 0), SheetPattern::one_to_four);  // face -z
+  EXPECT_EQ(hex_axis_pattern(edge_bits({0, 4}), 0), SheetPattern::one_to_four);  // face -y
+  EXPECT_EQ(hex_axis_pattern(edge_bits({0, 6}), 0), SheetPattern::multiply_connected);
+  EXPECT_EQ(hex_axis_pattern(edge_bits({8, 10}), 2), SheetPattern::multiply_connected);
+  EXPECT_EQ(hex_axis_pattern(edge_bits({9, 10}), 2), SheetPattern::one_to_four);  // face +x
+  EXPECT_EQ(hex_axis_pattern(edge_bits({1, 3, 5}), 1), SheetPattern::multiply_connected);
+  EXPECT_EQ(hex_axis_pattern(edge_bits({1, 3, 5, 7}), 1), SheetPattern::one_to_three);
+  EXPECT_TRUE(hex_is_multiply_connected(edge_bits({0, 2, 4, 1, 3})));
+  EXPECT_FALSE(hex_is_multiply_connected(edge_bits({0, 2, 1, 3})));  // a face: 1-4, 1-4
+}
+
+TEST(HexSplitMask, BothEndsMarked) {
+  const HexMesh m = fixture_brick(1, 1, 1);
+  std::vector<uint8_t> marked(8, 0);
+  for (int v : {0, 1, 3}) marked[m.hexes[0][v]] = 1;  // local edges e0 (0-1) and e3 (0-3)
+  EXPECT_EQ(hex_split_mask(m, marked, 0), edge_bits({0, 3}));
+}
+
+TEST(SheetMark, SingleTargetNeedsNoGrowth) {
+  const HexMesh m = fixture_brick(3, 3, 3);
+  const HexTopology t = topology_build(m);
+  const SheetMarking mk = sheet_mark(m, t, {{fixture_brick_hex(3, 3, 1, 1, 1)}});
+  EXPECT_EQ(mk.added_targets, 0);
+  EXPECT_EQ(std::count(mk.node_marked.begin(), mk.node_marked.end(), 1), 8);
+  EXPECT_EQ(std::count(mk.hex_target.begin(), mk.hex_target.end(), 1), 1);
+}
+
+TEST(SheetMark, TwoTargetsAcrossAnEdgeAddTheTwoCornerHexes) {
+  // In a 2x2x1 brick, targets (0,0) and (1,1): hexes (1,0) and (0,1) share a face with each,
+  // so three of their z-parallel edges are split (multiply connected): both are added.
+  const HexMesh m = fixture_brick(2, 2, 1);
+  const HexTopology t = topology_build(m);
+  const SheetMarking mk =
+      sheet_mark(m, t, {{fixture_brick_hex(2, 2, 0, 0, 0), fixture_brick_hex(2, 2, 1, 1, 0)}});
+  EXPECT_EQ(mk.added_targets, 2);
+  EXPECT_EQ(std::count(mk.hex_target.begin(), mk.hex_target.end(), 1), 4);
+}
+
+TEST(SheetMark, LShapedCaseGrowsToTheWholeBrick) {
+  // Thesis Table G-1: Harris' sheet refinement refines the whole 10x10x10 brick.
+  const HexMesh m = fixture_brick(10, 10, 10);
+  const HexTopology t = topology_build(m);
+  const Targets targets = l_shaped_targets(10);
+  ASSERT_EQ(targets.hexes.size(), 190u);
+  const SheetMarking mk = sheet_mark(m, t, targets);
+  EXPECT_EQ(mk.added_targets, 810);
+  EXPECT_EQ(std::count(mk.hex_target.begin(), mk.hex_target.end(), 1), 1000);
+}
+
+TEST(SheetRefine, RejectsInvalidTargets) {
+  const HexMesh m = fixture_brick(2, 2, 2);
+  EXPECT_THROW(sheet_refine(m, {{8}}, {}), InputError);
+  EXPECT_THROW(sheet_refine(m, {{3, 1}}, {}), InputError);
+  EXPECT_THROW(sheet_refine(m, {{1, 1}}, {}), InputError);
+  RefineOptions zero;
+  zero.passes = 0;
+  EXPECT_THROW(sheet_refine(m, {{1}}, zero), InputError);
+}
+
+TEST(SheetRefine, NoTargetsLeavesTheMeshUnchanged) {
+  const HexMesh m = fixture_brick(2, 2, 2);
+  const RefineResult r = sheet_refine(m, {}, {});
+  EXPECT_EQ(r.mesh.hexes, m.hexes);
+  EXPECT_EQ(r.mesh.point_count(), m.point_count());
+  EXPECT_EQ(r.stats.hexes_created, 0);
+  EXPECT_EQ(r.stats.sheet_passes, 0);
+  ASSERT_NE(mesh_find_attribute(r.mesh, attribute_template_tag), nullptr);
+}
+
+class FullBrick : public ::testing::TestWithParam<int> {};
+
+TEST_P(FullBrick, TwentySevenPerHexThroughThreeRounds) {
+  const int n = GetParam();
+  const HexMesh m = fixture_brick(n, n, n);
+  std::vector<int64_t> round_hexes;
+  const RefineResult r = sheet_refine(m, all_hexes(m), {}, [&](const HexMesh& inter, int round) {
+    EXPECT_EQ(round, static_cast<int>(round_hexes.size()));
+    round_hexes.push_back(inter.hex_count());
+    expect_conformal_brick(inter, n, n, n);  // conformal after every round
+  });
+  const int64_t n3 = int64_t(n) * n * n;
+  EXPECT_EQ(round_hexes, (std::vector<int64_t>{3 * n3, 9 * n3, 27 * n3}));
+  EXPECT_EQ(r.mesh.hex_count(), 27 * n3);
+  EXPECT_EQ(r.mesh.point_count(), (3 * n + 1) * (3 * n + 1) * (3 * n + 1));
+  EXPECT_EQ(r.stats.hexes_created, 39 * n3);
+  EXPECT_EQ(r.stats.hexes_deleted, 13 * n3);
+  EXPECT_EQ(r.stats.sheet_passes, 3 * n);  // every dual sheet of the brick once
+  EXPECT_EQ(r.stats.added_targets, 0);
+  EXPECT_EQ(r.stats.self_intersection_cases, 0);
+  EXPECT_EQ(r.stats.final_hexes, 27 * n3);
+  EXPECT_EQ(r.stats.hexes_per_template.at("sheet"), 27 * n3);
+  for (const char* phase : {"marking", "growth", "sheets", "total"})
+    EXPECT_EQ(r.stats.phase_seconds.count(phase), 1u) << phase;
+  const auto& level = *mesh_find_attribute(r.mesh, attribute_refinement_level);
+  EXPECT_TRUE(std::all_of(level.begin(), level.end(), [](int32_t l) { return l == 1; }));
+  // Every child is a cube of side 1/3.
+  for (int32_t h = 0; h < r.mesh.hex_count(); h += 7) {
+    const auto p = hex_points(r.mesh, h);
+    EXPECT_NEAR((p[6] - p[0]).norm(), std::sqrt(3.0) / 3, 1e-12);
+  }
+  expect_conformal_brick(r.mesh, n, n, n);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sizes, FullBrick, ::testing::Values(1, 2, 3, 5));
+
+TEST(SheetRefine, LShapedCaseRefinesTheWholeBrick) {
+  const HexMesh m = fixture_brick(10, 10, 10);
+  const RefineResult r = sheet_refine(m, l_shaped_targets(10), {});
+  EXPECT_EQ(r.mesh.hex_count(), 27000);  // thesis Table G-1
+  EXPECT_EQ(r.stats.added_targets, 810);
+  EXPECT_EQ(r.stats.hexes_created, 39000);
+  EXPECT_EQ(r.stats.hexes_deleted, 13000);
+  expect_conformal_brick(r.mesh, 10, 10, 10);
+}
+
+TEST(SheetRefine, AttributesInheritedAndUntouchedHexesKept) {
+  HexMesh m = fixture_brick(3, 1, 1);
+  m.attributes.push_back({"block_id", {7, 8, 9}});
+  // Targets 0 and 2 with hex 1 between: all nodes of hex 1 are target nodes, so as in Harris'
+  // node marking all its edges are split and it is fully refined too (not counted as added).
+  const RefineResult r = sheet_refine(m, {{0, 2}}, {});
+  EXPECT_EQ(r.stats.added_targets, 0);
+  EXPECT_EQ(r.mesh.hex_count(), 81);
+  const auto& block = *mesh_find_attribute(r.mesh, "block_id");
+  EXPECT_EQ(block.front(), 7);
+  EXPECT_EQ(block[27], 8);
+  EXPECT_EQ(block.back(), 9);
+  expect_conformal_brick(r.mesh, 3, 1, 1);
+}
+
+}  // namespace
+}  // namespace hexrefine

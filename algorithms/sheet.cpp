@@ -95,7 +95,8 @@ struct DirectionalTable {
 };
 
 const std::vector<const HexTemplate*>& directional_templates() {
-  static const std::vector<const HexTemplate*> list = {&template_1_3()};
+  static const std::vector<const HexTemplate*> list = {&template_1_3(), &template_1_4(),
+                                                       &template_1_5()};
   return list;
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "algorithms/templates.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
 #include "mesh/topology.hpp"
@@ -20,16 +21,14 @@ uint16_t edge_bits(std::initializer_list<int> edges) {
   return m;
 }
 
-// What a conformal, valid mesh of the box [lo, hi] satisfies, checked from its topology:
-// every face is shared by two hexes unless it lies on the box surface (a hanging node or a
-// mismatched face template leaves an interior face with one hex), the boundary faces cover the
-// box surface exactly once, no two points coincide, and every corner Jacobian is positive.
-void expect_conformal_box(const HexMesh& m, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+// Boundary faces of `m` (from its topology) that do not lie on the surface of the box [lo, hi]:
+// a hanging node or mismatched face templates leave such an open interior face. Adds the area
+// of all boundary faces to `area`.
+int interior_open_faces(const HexMesh& m, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                        double& area) {
   const HexTopology t = topology_build(m);
-  ASSERT_TRUE(t.nonmanifold_faces.empty());
   const double tol = 1e-9;
-  double area = 0;
-  int interior_open = 0;
+  int open = 0;
   for (int32_t f : topology_boundary_faces(t)) {
     const auto& q = t.face_nodes[f];
     bool on_plane = false;
@@ -39,12 +38,23 @@ void expect_conformal_box(const HexMesh& m, const Eigen::Vector3d& lo, const Eig
         for (int32_t v : q) all = all && std::abs(m.points[v][k] - side) < tol;
         on_plane = on_plane || all;
       }
-    interior_open += !on_plane;
+    open += !on_plane;
     const Eigen::Vector3d a = m.points[q[0]], b = m.points[q[1]], c = m.points[q[2]],
                           d = m.points[q[3]];
     area += 0.5 * ((b - a).cross(c - a).norm() + (c - a).cross(d - a).norm());
   }
-  EXPECT_EQ(interior_open, 0);
+  return open;
+}
+
+// What a conformal, valid mesh of the box [lo, hi] satisfies, checked from its topology:
+// no non-manifold face, no open interior face, the boundary faces cover the box surface exactly
+// once, no two points coincide, no unused point, and every corner Jacobian is positive.
+void expect_conformal_box(const HexMesh& m, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const HexTopology t = topology_build(m);
+  ASSERT_TRUE(t.nonmanifold_faces.empty());
+  const double tol = 1e-9;
+  double area = 0;
+  EXPECT_EQ(interior_open_faces(m, lo, hi, area), 0);
   const Eigen::Vector3d s = hi - lo;
   EXPECT_NEAR(area, 2 * (s.x() * s.y() + s.y() * s.z() + s.z() * s.x()), 1e-6);
   std::vector<std::array<double, 3>> pts;
@@ -228,6 +238,188 @@ TEST(SheetRefine, AttributesInheritedAndUntouchedHexesKept) {
   EXPECT_EQ(block[27], 8);
   EXPECT_EQ(block.back(), 9);
   expect_conformal_brick(r.mesh, 3, 1, 1);
+}
+
+TEST(SheetRefine, FaceTransitionIsOneToThirteenThroughTwoDirections) {
+  // Target 0 of a 3x1x1 brick: hex 1 shares a face with it (1-4 in y, then the three children
+  // on that face 1-4 in z: 3 * 4 + 1 = 13, like the 1-13 template); hex 2 is untouched.
+  const HexMesh m = fixture_brick(3, 1, 1);
+  std::vector<int64_t> round_hexes;
+  const RefineResult r = sheet_refine(m, {{0}}, {}, [&](const HexMesh& inter, int) {
+    round_hexes.push_back(inter.hex_count());
+    expect_conformal_brick(inter, 3, 1, 1);
+  });
+  EXPECT_EQ(r.mesh.hex_count(), 27 + 13 + 1);
+  // Rounds x, y, z: the target's slabs (3), then y (9 + hex 1's 1-4), then z.
+  EXPECT_EQ(round_hexes, (std::vector<int64_t>{3 + 1 + 1, 9 + 4 + 1, 41}));
+  EXPECT_EQ(r.stats.added_targets, 0);
+  EXPECT_EQ(r.stats.hexes_per_template.at("untouched"), 1);
+  expect_conformal_brick(r.mesh, 3, 1, 1);
+}
+
+TEST(SheetRefine, EdgeTransitionIsOneToFive) {
+  // Target (0,0,0) of a 2x2x1 brick: hexes (1,0,0) and (0,1,0) are face transitions (13 each),
+  // hex (1,1,0) shares only the z-edge at (1,1): a 1-5 in z.
+  const HexMesh m = fixture_brick(2, 2, 1);
+  const RefineResult r = sheet_refine(m, {{0}}, {});
+  EXPECT_EQ(r.mesh.hex_count(), 27 + 13 + 13 + 5);
+  EXPECT_EQ(r.stats.added_targets, 0);
+  expect_conformal_brick(r.mesh, 2, 2, 1);
+}
+
+// n^3 brick with interior nodes moved by up to `amount` in each coordinate (boundary nodes stay
+// on the box so expect_conformal_box applies).
+HexMesh jittered_brick(int n, double amount, uint32_t seed) {
+  HexMesh m = fixture_brick(n, n, n);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> d(-amount, amount);
+  for (auto& p : m.points) {
+    bool interior = true;
+    for (int k = 0; k < 3; ++k) interior = interior && p[k] > 0.5 && p[k] < n - 0.5;
+    if (interior)
+      for (int k = 0; k < 3; ++k) p[k] += d(rng);
+  }
+  return m;
+}
+
+// Checks one refinement: conformal and valid, counts consistent, and the added targets are
+// exactly those of the growth on the original mesh, after which no transition is multiply
+// connected.
+void expect_sheet_case(const HexMesh& m, int n, const Targets& targets, const std::string& what) {
+  SCOPED_TRACE(what);
+  const RefineResult r = sheet_refine(m, targets, {});
+  expect_conformal_box(r.mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(n));
+  EXPECT_EQ(r.mesh.hex_count(), m.hex_count() + r.stats.hexes_created - r.stats.hexes_deleted);
+  const HexTopology t = topology_build(m);
+  const SheetMarking mk = sheet_mark(m, t, targets);
+  EXPECT_EQ(r.stats.added_targets, mk.added_targets);
+  for (int32_t h = 0; h < m.hex_count(); ++h) {
+    if (!mk.hex_target[h]) {
+      EXPECT_FALSE(hex_is_multiply_connected(hex_split_mask(m, mk.node_marked, h)));
+    }
+  }
+  // Every (grown) target becomes 27 hexes, so the mesh grows by at least 26 per target.
+  const int64_t targets_after = std::count(mk.hex_target.begin(), mk.hex_target.end(), 1);
+  EXPECT_GE(r.mesh.hex_count(), m.hex_count() + 26 * targets_after);
+}
+
+TEST(SheetRefine, RadialRegionsAroundACorner) {
+  // Hexes whose centroid lies within a fixed radius of the corner (n, n, n), as thesis Table
+  // G-3 (brick size fixed at 1, interval n growing).
+  for (int n : {3, 4, 5, 6, 8}) {
+    const HexMesh m = fixture_brick(n, n, n, 1.0);
+    Targets t;
+    for (int32_t h = 0; h < m.hex_count(); ++h)
+      if ((hex_centroid(m, h) - Eigen::Vector3d::Constant(n)).norm() < 0.45 * n)
+        t.hexes.push_back(h);
+    ASSERT_FALSE(t.hexes.empty());
+    expect_sheet_case(m, n, t, "radial n=" + std::to_string(n));
+  }
+}
+
+TEST(SheetRefine, RandomTargetsOnJitteredBricks) {
+  int cases = 0, grown = 0;
+  for (int n : {4, 6}) {
+    for (uint32_t seed = 1; seed <= 100; ++seed) {
+      const HexMesh m = jittered_brick(n, 0.12, seed);
+      std::mt19937 rng(1000 + seed);
+      std::bernoulli_distribution pick(seed % 3 == 0 ? 0.3 : 0.08);
+      Targets t;
+      for (int32_t h = 0; h < m.hex_count(); ++h)
+        if (pick(rng)) t.hexes.push_back(h);
+      const RefineResult r = sheet_refine(m, t, {});
+      grown += r.stats.added_targets > 0;
+      expect_sheet_case(m, n, t, "n=" + std::to_string(n) + " seed=" + std::to_string(seed));
+      ++cases;
+      if (HasFailure()) return;
+    }
+  }
+  EXPECT_EQ(cases, 200);
+  EXPECT_GT(grown, 50);  // the random sets do exercise the growth
+}
+
+TEST(ExpectConformalBox, DetectsAHangingFace) {
+  // The check above must be able to fail: one hex of two split into slabs across the shared
+  // face's edges leaves hanging nodes.
+  const HexMesh m = fixture_brick(2, 1, 1);
+  const HexTopology t = topology_build(m);
+  int8_t across_y = -1;  // an orientation splitting the y-parallel edges
+  for (int i = 0; i < 48 && across_y < 0; ++i)
+    if (cube_symmetry_edge_mask(cube_symmetries()[i], template_split_edges(template_1_3())) ==
+        edge_bits({1, 3, 5, 7}))
+      across_y = static_cast<int8_t>(i);
+  const std::vector<TemplateApplication> apps = {{0, &template_1_3(), across_y}};
+  HexMesh broken = templates_apply(m, t, apps).mesh;
+  ASSERT_EQ(broken.hex_count(), 4);
+  double area = 0;
+  // The three slabs' faces on one side, the whole face on the other.
+  EXPECT_EQ(interior_open_faces(broken, Eigen::Vector3d::Zero(), Eigen::Vector3d(2, 1, 1), area),
+            4);
+  EXPECT_NEAR(area, 10.0 + 2.0, 1e-12);
+}
+
+// A ring of `segments` hexes with a 1x1 cross-section turned by 90 degrees once around: the
+// dual sheet of the cross-section edges closes onto itself with its two directions swapped, so
+// it crosses itself in every hex.
+HexMesh twisted_ring(int segments) {
+  HexMesh m;
+  const double pi = std::acos(-1.0), radius = 4.0;
+  for (int i = 0; i < segments; ++i) {
+    const double theta = 2 * pi * i / segments, phi = 0.5 * pi * i / segments;
+    const Eigen::Vector3d u(std::cos(theta), std::sin(theta), 0), w(0, 0, 1);
+    for (int c = 0; c < 4; ++c) {
+      const double a = phi + 0.25 * pi + 0.5 * pi * c;
+      m.points.push_back(radius * u + std::sqrt(0.5) * (std::cos(a) * u + std::sin(a) * w));
+    }
+  }
+  auto node = [&](int i, int c) {
+    return i < segments ? 4 * i + c : (c + 1) % 4;  // the last section is the first, turned
+  };
+  for (int i = 0; i < segments; ++i)
+    m.hexes.push_back({node(i, 0), node(i, 3), node(i, 2), node(i, 1), node(i + 1, 0),
+                       node(i + 1, 3), node(i + 1, 2), node(i + 1, 1)});
+  return m;
+}
+
+double boundary_area(const HexMesh& m) {
+  const HexTopology t = topology_build(m);
+  double area = 0;
+  for (int32_t f : topology_boundary_faces(t)) {
+    const auto& q = t.face_nodes[f];
+    const Eigen::Vector3d a = m.points[q[0]], b = m.points[q[1]], c = m.points[q[2]],
+                          d = m.points[q[3]];
+    area += 0.5 * ((b - a).cross(c - a).norm() + (c - a).cross(d - a).norm());
+  }
+  return area;
+}
+
+TEST(SheetRefine, TwistedRingFullyRefinedIsRefusedNamingTheSheet) {
+  const HexMesh ring = twisted_ring(8);
+  Targets all;
+  for (int32_t h = 0; h < 8; ++h) all.hexes.push_back(h);
+  try {
+    sheet_refine(ring, all, {});
+    FAIL() << "expected OperationError";
+  } catch (const OperationError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("crosses itself in hexes 0, 1, 2"), std::string::npos) << what;
+    EXPECT_NE(what.find("dual sheet of edge"), std::string::npos) << what;
+  }
+}
+
+TEST(SheetRefine, TwistedRingLocallyRefinedIsHandled) {
+  // One target: the sheet still crosses itself in the three affected hexes, but each of its
+  // pieces refines only one direction of a hex, so no hex needs two directions in one pass.
+  const HexMesh ring = twisted_ring(8);
+  const RefineResult r = sheet_refine(ring, {{3}}, {});
+  EXPECT_EQ(r.stats.self_intersection_cases, 3);
+  EXPECT_EQ(r.stats.added_targets, 0);
+  EXPECT_EQ(r.mesh.hex_count(), 27 + 2 * 13 + 5);
+  const HexTopology t = topology_build(r.mesh);
+  EXPECT_TRUE(t.nonmanifold_faces.empty());
+  // No interior face left open: the boundary is the ring's surface (its side faces are not
+  // planar, so their split area differs slightly; an open interior face would add 1 or more).
+  EXPECT_NEAR(boundary_area(r.mesh), boundary_area(ring), 0.3);
 }
 
 }  // namespace

@@ -19,11 +19,15 @@ const char* usage_text =
     "  generate brick OUT --dims NX,NY,NZ [--size LX,LY,LZ] [--jitter F --seed S]\n"
     "  generate gear|cylinder|twisted-ring|stepped OUT [options]\n"
     "  check MESH [--report R.json]\n"
-    "  convert IN OUT\n"
+    "  convert IN OUT [--binary]\n"
     "  sheets MESH [--report R.json]\n"
     "  refine IN OUT --method selective|sheet --select SPEC [--select SPEC ...] [--passes N]\n"
     "         [--buffer] [--smooth] [--no-ranking] [--no-propagation] [--ebe-only]\n"
     "         [--allow-inverted] [--report R.json]\n"
+    "  smooth IN OUT [--method laplacian|optimize] [--region SPEC ...] [--report R.json]\n"
+    "  run CASES.json [--resume] [--quiet] [--shard K/N]\n"
+    "  reproduce [--quick] [--resume] [--quiet]\n"
+    "  merge OUT.jsonl IN.jsonl [IN.jsonl ...]\n"
     "exit codes: 0 done, 1 the operation failed, 2 bad usage or bad input\n";
 
 }  // namespace
@@ -129,8 +133,9 @@ int cli_main(int argc, char** argv) {
   const std::string command = args[0];
   args.erase(args.begin());
   static const std::map<std::string, int (*)(const std::vector<std::string>&)> commands = {
-      {"generate", cli_generate}, {"check", cli_check},   {"convert", cli_convert},
-      {"sheets", cli_sheets},     {"refine", cli_refine},
+      {"generate", cli_generate}, {"check", cli_check},         {"convert", cli_convert},
+      {"sheets", cli_sheets},     {"refine", cli_refine},       {"smooth", cli_smooth},
+      {"run", cli_run},           {"reproduce", cli_reproduce}, {"merge", cli_merge},
   };
   const auto it = commands.find(command);
   if (it == commands.end()) {

@@ -40,5 +40,9 @@ int cli_check(const std::vector<std::string>& args);
 int cli_convert(const std::vector<std::string>& args);
 int cli_sheets(const std::vector<std::string>& args);
 int cli_refine(const std::vector<std::string>& args);
+int cli_smooth(const std::vector<std::string>& args);
+int cli_run(const std::vector<std::string>& args);
+int cli_reproduce(const std::vector<std::string>& args);
+int cli_merge(const std::vector<std::string>& args);
 
 }  // namespace hexrefine

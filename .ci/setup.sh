@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Installs hexrefine's build, test and plotting dependencies from Debian's packages (idempotent).
+set -euo pipefail
+packages=(cmake g++ make clang-format libeigen3-dev libopenmesh-dev nlohmann-json3-dev libgtest-dev
+          libbenchmark-dev libexodusii-dev python3-meshio python3-vtk9 python3-matplotlib gmsh)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}"
+fi

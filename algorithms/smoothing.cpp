@@ -45,6 +45,7 @@
 
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
 
 namespace hexrefine {
 
@@ -65,34 +66,20 @@ Mat3 corner_matrix(const Corners& p, int v) {
   return a;
 }
 
-/// Centre sample: column k is the mean of the four edges along axis k.
-Mat3 centre_matrix(const Corners& p) {
-  Mat3 a = Mat3::Zero();
+/// The 9 samples whose minimum is hex_scaled_jacobian (mesh/quality.hpp): corners 0..7, then the
+/// centre, each det(A) / (|a1| |a2| |a3|) clamped to [-1, 1] (0 for a zero-length column). The
+/// ascent needs every sample, not only the minimum; the guard itself uses hex_scaled_jacobian.
+void corners_scaled_jacobian_samples(const Corners& p, double* samples) {
+  auto scaled = [](const Mat3& a) {
+    const double lengths = a.col(0).norm() * a.col(1).norm() * a.col(2).norm();
+    if (!(lengths > std::numeric_limits<double>::min())) return 0.0;
+    return std::clamp(a.determinant() / lengths, -1.0, 1.0);
+  };
+  for (int v = 0; v < 8; ++v) samples[v] = scaled(corner_matrix(p, v));
+  Mat3 centre = Mat3::Zero();
   for (int k = 0; k < 3; ++k)
-    for (int e : hex_axis_edges[k]) a.col(k) += p[hex_edges[e][1]] - p[hex_edges[e][0]];
-  return a / 4.0;
-}
-
-/// det(A) / (|a1| |a2| |a3|) clamped to [-1, 1]; 0 if a column has zero length.
-double sample_scaled_jacobian(const Mat3& a) {
-  const double lengths = a.col(0).norm() * a.col(1).norm() * a.col(2).norm();
-  if (!(lengths > std::numeric_limits<double>::min())) return 0.0;
-  return std::clamp(a.determinant() / lengths, -1.0, 1.0);
-}
-
-/// The scaled Jacobian of a hex: min over the 8 corner samples and the centre sample (the same
-/// definition as hex_scaled_jacobian in mesh/quality.hpp; range [-1, 1], unit cube 1). `samples`,
-/// if given, receives the 9 sample values (centre last).
-double corners_scaled_jacobian(const Corners& p, double* samples = nullptr) {
-  double best = 1.0;
-  for (int v = 0; v < 8; ++v) {
-    const double s = sample_scaled_jacobian(corner_matrix(p, v));
-    if (samples) samples[v] = s;
-    best = std::min(best, s);
-  }
-  const double c = sample_scaled_jacobian(centre_matrix(p));
-  if (samples) samples[8] = c;
-  return std::min(best, c);
+    for (int e : hex_axis_edges[k]) centre.col(k) += p[hex_edges[e][1]] - p[hex_edges[e][0]];
+  samples[8] = scaled(centre / 4.0);
 }
 
 /// Local vertex of node n in hex cell c (precondition: n is in c).
@@ -171,7 +158,7 @@ class Smoother {
   }
 
  private:
-  double hex_quality(int32_t h) const { return corners_scaled_jacobian(hex_points(mesh_, h)); }
+  double hex_quality(int32_t h) const { return hex_scaled_jacobian(hex_points(mesh_, h)); }
 
   bool node_is_planar(int32_t n) const { return classes_.kind[n] == SmoothNodeKind::planar; }
 
@@ -354,7 +341,8 @@ class Smoother {
     size_t count = 0;
     double m = 1.0;
     for (int32_t h : node_hexes(topology_, n)) {
-      m = std::min(m, corners_scaled_jacobian(hex_points(mesh_, h), &trial_samples_[count]));
+      corners_scaled_jacobian_samples(hex_points(mesh_, h), &trial_samples_[count]);
+      for (int k = 0; k < 9; ++k) m = std::min(m, trial_samples_[count + k]);
       count += 9;
     }
     mesh_.points[n] = keep;
@@ -553,6 +541,15 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
   stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   return stats;
+}
+
+std::vector<int32_t> mesh_refined_hexes(const HexMesh& mesh) {
+  std::vector<int32_t> out;
+  const std::vector<int32_t>* tags = mesh_find_attribute(mesh, attribute_template_tag);
+  if (!tags) return out;
+  for (int32_t h = 0; h < static_cast<int32_t>(tags->size()); ++h)
+    if ((*tags)[h] != 0) out.push_back(h);
+  return out;
 }
 
 nlohmann::json smooth_stats_to_json(const SmoothStats& s) {

@@ -75,6 +75,11 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options);
 /// after, seconds, sweeps, nodes moved.
 nlohmann::json smooth_stats_to_json(const SmoothStats& s);
 
+/// The default region of `refine --smooth`: the refined and transition hexes, i.e. those whose
+/// template_tag attribute is non-zero, ascending. Empty if there is none or the mesh has no
+/// template_tag (callers then skip smoothing: an empty SmoothOptions::region_hexes means all).
+std::vector<int32_t> mesh_refined_hexes(const HexMesh& mesh);
+
 /// "laplacian" / "optimize".
 const char* smooth_method_name(SmoothMethod m);
 

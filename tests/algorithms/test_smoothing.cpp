@@ -8,39 +8,18 @@
 
 #include "fixtures.hpp"
 #include "mesh/error.hpp"
-#include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
 #include "mesh/topology.hpp"
 
 namespace hexrefine {
 namespace {
 
-// Independent check of the scaled Jacobian (corner and centre samples, as mesh/quality.hpp
-// defines it), kept here until mesh/quality.hpp lands on main.
 double check_scaled_jacobian(const HexMesh& m, int32_t h) {
-  const auto p = hex_points(m, h);
-  auto sample = [](const Eigen::Matrix3d& a) {
-    const double l = a.col(0).norm() * a.col(1).norm() * a.col(2).norm();
-    return l > 0 ? std::clamp(a.determinant() / l, -1.0, 1.0) : 0.0;
-  };
-  Eigen::Matrix3d centre = Eigen::Matrix3d::Zero();
-  for (int k = 0; k < 3; ++k)
-    for (int e : hex_axis_edges[k]) centre.col(k) += (p[hex_edges[e][1]] - p[hex_edges[e][0]]) / 4;
-  double best = sample(centre);
-  for (int v = 0; v < 8; ++v) {
-    Eigen::Matrix3d a;
-    for (int k = 0; k < 3; ++k) {
-      const int e = hex_vertex_edges[v][k];
-      a.col(k) = p[hex_edges[e][1]] - p[hex_edges[e][0]];
-    }
-    best = std::min(best, sample(a));
-  }
-  return best;
+  return hex_scaled_jacobian(hex_points(m, h));
 }
 
 double check_min_scaled_jacobian(const HexMesh& m) {
-  double best = 1;
-  for (int32_t h = 0; h < m.hex_count(); ++h) best = std::min(best, check_scaled_jacobian(m, h));
-  return best;
+  return mesh_min_scaled_jacobian(m);
 }
 
 // Deterministic pseudo-random offset in [-1, 1] per (node, component).
@@ -322,6 +301,13 @@ TEST(Smoothing, BadOptionsAreInputErrors) {
   o = {};
   m.hexes[0][0] = 99;
   EXPECT_THROW(mesh_smooth(m, o), InputError);
+}
+
+TEST(Smoothing, RefinedHexesAreThoseWithATemplateTag) {
+  HexMesh m = fixture_brick(3, 1, 1);
+  EXPECT_TRUE(mesh_refined_hexes(m).empty());
+  mesh_attribute(m, attribute_template_tag) = {0, 5, 1};
+  EXPECT_EQ(mesh_refined_hexes(m), (std::vector<int32_t>{1, 2}));
 }
 
 TEST(Smoothing, StatsToJsonCarriesEveryField) {

@@ -34,7 +34,6 @@ int cli_run(const std::vector<std::string>& args) {
     throw InputError(
         "hexrefine run: expected one case file (usage: hexrefine run CASES.json "
         "[--resume] [--quiet] [--shard K/N] [--output OUT.jsonl])");
-  const RunPlan plan = run_plan_read(a.positional[0]);
   RunSettings settings;
   settings.resume = a.flag("--resume");
   settings.quiet = a.flag("--quiet");
@@ -44,6 +43,7 @@ int cli_run(const std::vector<std::string>& args) {
     settings.shard_count = n;
   }
   if (const auto out = a.value("--output")) settings.output = *out;
+  const RunPlan plan = run_plan_read(a.positional[0]);
   settings.progress = (!settings.quiet && ::isatty(2)) ? &std::cerr : nullptr;
   settings.environment = run_environment_detect();
   const RunSummary s = run_plan_execute(plan, settings, case_execute);

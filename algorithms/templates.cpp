@@ -151,6 +151,65 @@ Eigen::Vector3d trilinear(const std::array<Eigen::Vector3d, 8>& x, const std::ar
   return out;
 }
 
+// Determinant of the trilinear map's Jacobian at the reference centre (orientation test).
+double hex_center_jacobian(const std::array<Eigen::Vector3d, 8>& x) {
+  Eigen::Matrix3d j = Eigen::Matrix3d::Zero();
+  for (int v = 0; v < 8; ++v)
+    for (int k = 0; k < 3; ++k) {
+      double w = hex_corner[v][k] ? 1.0 : -1.0;
+      for (int m = 0; m < 3; ++m)
+        if (m != k) w *= 0.5;
+      j.col(k) += w * x[v];
+    }
+  return j.determinant();
+}
+
+// Builds a template in the canonical cube: nodes are deduplicated by position (adjustment nodes
+// are kept apart), and children are re-ordered to positive orientation if given mirrored, so
+// the template tables below can list children in the order that reads best.
+class TemplateBuilder {
+ public:
+  explicit TemplateBuilder(TemplateTag tag) { t_.tag = tag; }
+
+  int16_t node(double x, double y, double z) {
+    for (size_t i = 0; i < t_.nodes.size(); ++i) {
+      const TemplateNode& n = t_.nodes[i];
+      if (n.adjustment_edge < 0 && std::abs(n.ref[0] - x) < 1e-12 &&
+          std::abs(n.ref[1] - y) < 1e-12 && std::abs(n.ref[2] - z) < 1e-12)
+        return static_cast<int16_t>(i);
+    }
+    t_.nodes.push_back({{x, y, z}});
+    return static_cast<int16_t>(t_.nodes.size() - 1);
+  }
+
+  int16_t adjustment(int edge, int index, double x, double y, double z) {
+    TemplateNode n{{x, y, z}};
+    n.adjustment_edge = static_cast<int8_t>(edge);
+    n.adjustment_index = static_cast<int8_t>(index);
+    t_.nodes.push_back(n);
+    return static_cast<int16_t>(t_.nodes.size() - 1);
+  }
+
+  void child(std::array<int16_t, 8> c) {
+    std::array<Eigen::Vector3d, 8> x;
+    for (int k = 0; k < 8; ++k) {
+      const auto& r = t_.nodes[c[k]].ref;
+      x[k] = Eigen::Vector3d(r[0], r[1], r[2]);
+    }
+    if (hex_center_jacobian(x) < 0) c = {c[0], c[3], c[2], c[1], c[4], c[7], c[6], c[5]};
+    t_.children.push_back(c);
+  }
+
+  // A hex from two quads ("bottom" a, "top" b) whose corners correspond.
+  void child(const std::array<int16_t, 4>& a, const std::array<int16_t, 4>& b) {
+    child({a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]});
+  }
+
+  HexTemplate take() { return std::move(t_); }
+
+ private:
+  HexTemplate t_;
+};
 }  // namespace
 
 const std::array<CubeSymmetry, 48>& cube_symmetries() {
@@ -367,6 +426,156 @@ const HexTemplate& template_1_3() {
       r.children.push_back({id(i, 0, 0), id(i + 1, 0, 0), id(i + 1, 1, 0), id(i, 1, 0), id(i, 0, 1),
                             id(i + 1, 0, 1), id(i + 1, 1, 1), id(i, 1, 1)});
     return r;
+  }();
+  return t;
+}
+
+}  // namespace hexrefine
+
+namespace hexrefine {
+
+namespace {
+
+// Scaled Jacobian of a hex (Knupp): the minimum over the 8 corners and the centre of the
+// determinant of the three unit edge (or principal axis) vectors. 1 for a cube, <= 0 inverted.
+double child_scaled_jacobian(const std::array<Eigen::Vector3d, 8>& x) {
+  double out = 2.0;
+  for (int v = 0; v < 8; ++v) {
+    std::array<Eigen::Vector3d, 3> e;
+    for (int k = 0; k < 3; ++k) {
+      const int edge = hex_vertex_edges[v][k];
+      const int w = hex_edges[edge][0] == v ? hex_edges[edge][1] : hex_edges[edge][0];
+      // Point along +axis so the triple product of a positive hex is positive.
+      e[k] = hex_corner[v][k] ? (x[v] - x[w]) : (x[w] - x[v]);
+      const double n = e[k].norm();
+      if (n == 0) return -1.0;
+      e[k] /= n;
+    }
+    out = std::min(out, e[0].dot(e[1].cross(e[2])));
+  }
+  std::array<Eigen::Vector3d, 3> a;
+  for (int k = 0; k < 3; ++k) {
+    a[k] = Eigen::Vector3d::Zero();
+    for (int v = 0; v < 8; ++v) a[k] += (hex_corner[v][k] ? 0.25 : -0.25) * x[v];
+    const double n = a[k].norm();
+    if (n == 0) return -1.0;
+    a[k] /= n;
+  }
+  return std::min(out, a[0].dot(a[1].cross(a[2])));
+}
+
+// Volume of a trilinear hex by 2x2x2 Gauss quadrature of its Jacobian determinant.
+double child_volume(const std::array<Eigen::Vector3d, 8>& x) {
+  const double g[2] = {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)};
+  double vol = 0;
+  for (double r : g)
+    for (double s : g)
+      for (double t : g) {
+        const double p[3] = {r, s, t};
+        Eigen::Matrix3d j = Eigen::Matrix3d::Zero();
+        for (int v = 0; v < 8; ++v)
+          for (int k = 0; k < 3; ++k) {
+            double w = hex_corner[v][k] ? 1.0 : -1.0;
+            for (int m = 0; m < 3; ++m)
+              if (m != k) w *= hex_corner[v][m] ? p[m] : 1.0 - p[m];
+            j.col(k) += w * x[v];
+          }
+        vol += j.determinant() / 8.0;
+      }
+  return vol;
+}
+
+}  // namespace
+
+double template_validate(const HexTemplate& tmpl) {
+  auto fail = [&](const std::string& why) {
+    throw OperationError(std::string("template ") + template_tag_name(tmpl.tag) + ": " + why);
+  };
+  double min_sj = 2.0, volume = 0.0;
+  std::vector<std::array<int16_t, 4>> faces;
+  for (size_t c = 0; c < tmpl.children.size(); ++c) {
+    std::array<Eigen::Vector3d, 8> x;
+    for (int k = 0; k < 8; ++k) {
+      const auto& r = tmpl.nodes.at(tmpl.children[c][k]).ref;
+      x[k] = Eigen::Vector3d(r[0], r[1], r[2]);
+    }
+    const double sj = child_scaled_jacobian(x);
+    if (sj <= 0) fail("child " + std::to_string(c) + " is inverted or degenerate");
+    min_sj = std::min(min_sj, sj);
+    volume += child_volume(x);
+    for (int f = 0; f < 6; ++f) {
+      std::array<int16_t, 4> q;
+      for (int i = 0; i < 4; ++i) q[i] = tmpl.children[c][hex_faces[f][i]];
+      std::sort(q.begin(), q.end());
+      faces.push_back(q);
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  for (size_t i = 0; i + 2 < faces.size(); ++i)
+    if (faces[i] == faces[i + 2]) fail("a face is shared by more than two children");
+  // Adjustment templates leave a wedge at their unsplit edge to the neighbours (Appendix E).
+  bool adjusted = false;
+  for (const TemplateNode& n : tmpl.nodes) adjusted |= n.adjustment_edge >= 0;
+  if (!adjusted && std::abs(volume - 1.0) > 1e-9)
+    fail("children fill volume " + std::to_string(volume) + ", not the unit cube");
+  if (adjusted && (volume >= 1.0 - 1e-9 || volume <= 0.5))
+    fail("adjusted children fill volume " + std::to_string(volume));
+  return min_sj;
+}
+
+const HexTemplate& template_1_4() {
+  // e0 and e4 split (the two x-edges of face y=0): face y=0 is a 1-3 face, faces z=0 and z=1
+  // carry the 1-4 face template (interior nodes at y = 1/2, on the sixths grid of face slots),
+  // faces x=0, x=1 and y=1 stay whole: the 2D 1-4 quad template extruded along z.
+  static const HexTemplate t = [] {
+    TemplateBuilder b(TemplateTag::t1_4);
+    // Section points (x, y) of the 2D template, extruded over z in {0, 1}.
+    const double sec[8][2] = {{0, 0}, {1 / 3.0, 0}, {2 / 3.0, 0},   {1, 0},
+                              {1, 1}, {0, 1},       {1 / 3.0, 0.5}, {2 / 3.0, 0.5}};
+    enum { A, P1, P2, B, C, D, Q1, Q2 };
+    const int quads[4][4] = {{A, P1, Q1, D}, {P1, P2, Q2, Q1}, {P2, B, C, Q2}, {Q1, Q2, C, D}};
+    for (const auto& q : quads) {
+      std::array<int16_t, 8> c{};
+      for (int k = 0; k < 2; ++k)
+        for (int i = 0; i < 4; ++i) c[4 * k + i] = b.node(sec[q[i]][0], sec[q[i]][1], k);
+      b.child(c);
+    }
+    return b.take();
+  }();
+  return t;
+}
+
+const HexTemplate& template_1_5() {
+  // e0 split (the x-edge at y=0, z=0): faces y=0 and z=0 carry 1-4 face templates (transition
+  // nodes at 1/2), two interior nodes (1/3, 1/2, 1/2) and (2/3, 1/2, 1/2). The two end children
+  // hold the whole faces x=0 and x=1; a middle box [1/3,2/3] x [0,1/2]^2 sits on the split edge;
+  // two upper children share the face (1/3,h,h) (2/3,h,h) (1,1,1) (0,1,1): one holds face y=1,
+  // the other face z=1. Five children.
+  static const HexTemplate t = [] {
+    TemplateBuilder b(TemplateTag::t1_5);
+    const double h = 0.5;
+    // Section (y, z) at x: the whole face, and the small square [0,h]^2.
+    auto whole = [&](double x) {
+      return std::array<int16_t, 4>{b.node(x, 0, 0), b.node(x, 1, 0), b.node(x, 1, 1),
+                                    b.node(x, 0, 1)};
+    };
+    auto small = [&](double x) {
+      return std::array<int16_t, 4>{b.node(x, 0, 0), b.node(x, h, 0), b.node(x, h, h),
+                                    b.node(x, 0, h)};
+    };
+    const double x1 = 1 / 3.0, x2 = 2 / 3.0;
+    b.child(whole(0), small(x1));
+    b.child(small(x1), small(x2));
+    b.child(small(x2), whole(1));
+    const int16_t i1 = b.node(x1, h, h), i2 = b.node(x2, h, h);
+    const int16_t top0 = b.node(0, 1, 1), top1 = b.node(1, 1, 1);
+    // Holds face y=1: bottom quad on z=0.
+    b.child(
+        {b.node(x1, h, 0), b.node(x2, h, 0), b.node(1, 1, 0), b.node(0, 1, 0), i1, i2, top1, top0});
+    // Holds face z=1: bottom quad on y=0.
+    b.child(
+        {b.node(x1, 0, h), b.node(x2, 0, h), b.node(1, 0, 1), b.node(0, 0, 1), i1, i2, top1, top0});
+    return b.take();
   }();
   return t;
 }

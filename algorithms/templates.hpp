@@ -112,6 +112,10 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
 const HexTemplate& template_1_27();
 /// 1-3: the four x-parallel edges (e0 e2 e4 e6) split; three slabs across x.
 const HexTemplate& template_1_3();
+/// 1-4: two parallel edges of one face split (e0, e4: face y=0); the 2D 1-4 extruded, 4 children.
+const HexTemplate& template_1_4();
+/// 1-5: one edge split (e0); faces y=0 and z=0 carry 1-4 face templates; 5 children.
+const HexTemplate& template_1_5();
 
 /// Checks a template on the unit cube: every child has positive scaled Jacobian, children fill the
 /// cube (volumes sum to 1), and no face is shared by more than two children. Returns the minimum

@@ -2,14 +2,104 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <set>
 
+#include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
 #include "mesh/topology.hpp"
 #include "tests/fixtures.hpp"
 
 namespace hexrefine {
 namespace {
+
+using Point2 = std::array<long, 2>;   // face coordinates in sixths
+using Quad2 = std::array<Point2, 4>;  // sorted
+
+Quad2 quad_sorted(Quad2 q) {
+  std::sort(q.begin(), q.end());
+  return q;
+}
+
+// The face template a face must carry given which of its sides are split (sides: 0 v=0, 1 u=1,
+// 2 v=1, 3 u=0), as sorted quads in sixths.
+std::set<Quad2> face_template_expected(const std::array<bool, 4>& split) {
+  std::set<Quad2> out;
+  const int n = split[0] + split[1] + split[2] + split[3];
+  auto add = [&](std::vector<Quad2> quads, int side) {
+    for (Quad2 q : quads) {
+      for (Point2& p : q) {
+        const long u = p[0], v = p[1];
+        if (side == 1) p = {6 - v, u};
+        if (side == 2) p = {u, 6 - v};
+        if (side == 3) p = {v, u};
+      }
+      out.insert(quad_sorted(q));
+    }
+  };
+  if (n == 0) {
+    add({{{{0, 0}, {6, 0}, {6, 6}, {0, 6}}}}, 0);
+  } else if (n == 1) {
+    const int side = split[0] ? 0 : split[1] ? 1 : split[2] ? 2 : 3;
+    add({{{{0, 0}, {2, 0}, {2, 3}, {0, 6}}},
+         {{{2, 0}, {4, 0}, {4, 3}, {2, 3}}},
+         {{{4, 0}, {6, 0}, {6, 6}, {4, 3}}},
+         {{{2, 3}, {4, 3}, {6, 6}, {0, 6}}}},
+        side);
+  } else if (n == 2 && split[0] == split[2]) {
+    add({{{{0, 0}, {2, 0}, {2, 6}, {0, 6}}},
+         {{{2, 0}, {4, 0}, {4, 6}, {2, 6}}},
+         {{{4, 0}, {6, 0}, {6, 6}, {4, 6}}}},
+        split[0] ? 0 : 1);
+  } else if (n == 4) {
+    std::vector<Quad2> q;
+    for (long i = 0; i < 3; ++i)
+      for (long j = 0; j < 3; ++j)
+        q.push_back(
+            {{{2 * i, 2 * j}, {2 * i + 2, 2 * j}, {2 * i + 2, 2 * j + 2}, {2 * i, 2 * j + 2}}});
+    add(q, 0);
+  }
+  return out;
+}
+
+// Checks every face of a canonical template against the face template its split sides call for.
+// Faces listed in `collapsed` (adjusted faces) are skipped. Returns the number of faces checked.
+int template_faces_check(const HexTemplate& t, std::set<int> collapsed = {}) {
+  auto six = [](double x) { return std::lround(6 * x); };
+  int checked = 0;
+  for (int f = 0; f < 6; ++f) {
+    if (collapsed.count(f)) continue;
+    const int axis = f / 2, side = f % 2;
+    const int ua = axis == 0 ? 1 : 0, va = axis == 2 ? 1 : 2;
+    std::array<bool, 4> split{};
+    for (const TemplateNode& n : t.nodes) {
+      if (n.adjustment_edge >= 0 || six(n.ref[axis]) != 6 * side) continue;
+      const long u = six(n.ref[ua]), v = six(n.ref[va]);
+      if (std::abs(6 * n.ref[ua] - u) > 1e-9 || std::abs(6 * n.ref[va] - v) > 1e-9) continue;
+      if (u == 2 && v == 0) split[0] = true;
+      if (u == 6 && v == 2) split[1] = true;
+      if (u == 2 && v == 6) split[2] = true;
+      if (u == 0 && v == 2) split[3] = true;
+    }
+    std::set<Quad2> actual;
+    for (const auto& c : t.children) {
+      for (int lf = 0; lf < 6; ++lf) {
+        Quad2 q;
+        bool on = true;
+        for (int i = 0; i < 4; ++i) {
+          const TemplateNode& n = t.nodes[c[hex_faces[lf][i]]];
+          on = on && n.adjustment_edge < 0 && std::abs(n.ref[axis] - side) < 1e-12;
+          q[i] = {six(n.ref[ua]), six(n.ref[va])};
+        }
+        if (on) actual.insert(quad_sorted(q));
+      }
+    }
+    EXPECT_EQ(actual, face_template_expected(split)) << template_tag_name(t.tag) << " face " << f;
+    ++checked;
+  }
+  return checked;
+}
 
 TEST(CubeSymmetries, FortyEightDistinctWithTwentyFourReflections) {
   const auto& s = cube_symmetries();
@@ -31,6 +121,32 @@ TEST(CubeSymmetries, FortyEightDistinctWithTwentyFourReflections) {
 TEST(Templates, SplitEdgeMasks) {
   EXPECT_EQ(template_split_edges(template_1_27()), 0xFFF);
   EXPECT_EQ(template_split_edges(template_1_3()), (1 << 0) | (1 << 2) | (1 << 4) | (1 << 6));
+  EXPECT_EQ(template_split_edges(template_1_4()), (1 << 0) | (1 << 4));
+  EXPECT_EQ(template_split_edges(template_1_5()), 1 << 0);
+}
+
+TEST(Templates, EachTemplateAloneIsValidWithTheRightChildCount) {
+  EXPECT_EQ(template_1_27().children.size(), 27u);
+  EXPECT_EQ(template_1_5().children.size(), 5u);
+  EXPECT_EQ(template_1_4().children.size(), 4u);
+  EXPECT_EQ(template_1_3().children.size(), 3u);
+  EXPECT_DOUBLE_EQ(template_validate(template_1_27()), 1.0);
+  EXPECT_DOUBLE_EQ(template_validate(template_1_3()), 1.0);
+  EXPECT_GT(template_validate(template_1_4()), 0.5);
+  EXPECT_GT(template_validate(template_1_5()), 0.4);
+}
+
+TEST(Templates, FacesMatchTheFaceTemplates) {
+  EXPECT_EQ(template_faces_check(template_1_27()), 6);
+  EXPECT_EQ(template_faces_check(template_1_3()), 6);
+  EXPECT_EQ(template_faces_check(template_1_4()), 6);
+  EXPECT_EQ(template_faces_check(template_1_5()), 6);
+}
+
+TEST(Templates, ValidateRejectsAnInvertedChild) {
+  HexTemplate t = template_1_3();
+  std::swap(t.children[1][0], t.children[1][1]);
+  EXPECT_THROW(template_validate(t), OperationError);
 }
 
 TEST(TemplatesApply, FullRefinementOfTwoCubedBrickSharesNodes) {

@@ -1,0 +1,101 @@
+#pragma once
+/// \file
+/// Conformity and validity checks of an all-hex mesh, independent of how the mesh was made (it
+/// knows nothing of the refiners). Every item is a count, not only a flag, so ablations can measure
+/// how far from conformal a result is.
+///
+/// Definitions (all tolerances relative, so the checks are scale-free):
+/// - non-manifold face: a quad (same four nodes) used by more than two hexes.
+/// - non-conformal face: a boundary face (used by one hex) that is not a true boundary face.
+///   * With a reference (the mesh before refinement): a boundary face whose four corners and
+///     centroid do not all lie on one boundary face of the reference. Refinement must subdivide
+///     the reference's boundary faces, so any other boundary face is one side of a gap between
+///     two hexes that should share a face (the T-junction faces of a 1-8 split beside an unsplit
+///     hex: the big face and its four small faces are all non-conformal).
+///   * Without a reference: a boundary face whose centroid lies on another boundary face of the
+///     same mesh (the two coincident sides of a gap). A gap that does not leave coincident faces
+///     (e.g. one hex moved away from its neighbour) cannot be told from true boundary without a
+///     reference and is not detected.
+///   "Lies on a face" = distance to the face's bilinear patch <= mesh_check_surface_tolerance
+///   times the face's longer diagonal.
+/// - hanging node (T-junction): a node of a non-conformal face that lies on another non-conformal
+///   face B, is not one of B's nodes, and is farther than the tolerance from each of B's corners
+///   (a different node at a corner's position is a duplicate node, not a hanging node). Each node
+///   counted once. For a hex split 1-8 beside an unsplit hex: 5 (4 edge midpoints, 1 face centre).
+/// - non-manifold boundary edge: an edge of a boundary face that does not lie in exactly two
+///   boundary faces (the boundary surface is not a closed 2-manifold there).
+/// - doublet: a pair of distinct hexes sharing two or more faces (counted once per pair).
+/// - inverted hex: hex_scaled_jacobian <= 0 (inverted or degenerate).
+/// - duplicate node: a node within 1e-12 x (bounding-box diagonal) of a node with a lower id.
+/// - unused node: a node no hex refers to.
+/// conformal = no non-manifold faces, no non-conformal faces, no hanging nodes, no non-manifold
+/// boundary edges and no doublets.
+///
+/// Reference comparison: total volume (sum of hex_volume) and boundary area (sum of the bilinear
+/// patch areas of the boundary faces) are compared with the reference's. If every boundary quad of
+/// the reference is planar (out-of-plane spread <= 1e-12 x its diagonal), refinement must preserve
+/// both to mesh_check_geometry_tolerance relative; otherwise the errors are only reported.
+///
+/// Time: linear in the mesh size (topology_build, hash grids over boundary faces); duplicate nodes
+/// by one sort of the quantised positions (n log n).
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "mesh/hex_mesh.hpp"
+
+namespace hexrefine {
+
+/// Relative distance under which a point counts as lying on a boundary face.
+inline constexpr double mesh_check_surface_tolerance = 1e-6;
+/// Relative volume and boundary-area error allowed for planar-faced references.
+inline constexpr double mesh_check_geometry_tolerance = 1e-9;
+/// Relative distance (to the bounding-box diagonal) under which two nodes are duplicates.
+inline constexpr double mesh_check_duplicate_tolerance = 1e-12;
+
+struct MeshCheckReport {
+  int64_t hexes = 0, nodes = 0;
+  bool conformal = true;
+  int64_t non_conformal_faces = 0;
+  int64_t hanging_nodes = 0;
+  int64_t inverted_hexes = 0;
+  int64_t doublets = 0;
+  int64_t nonmanifold_faces = 0;
+  int64_t nonmanifold_boundary_edges = 0;
+  int64_t duplicate_nodes = 0;
+  int64_t unused_nodes = 0;
+  int64_t boundary_faces = 0;
+  /// Over all hexes; 1 for an empty mesh.
+  double min_scaled_jacobian = 1.0, mean_scaled_jacobian = 1.0;
+  /// Sum of signed hex volumes; sum of boundary-face areas.
+  double volume = 0.0, boundary_area = 0.0;
+  /// Lowest id of an inverted hex, -1 if none.
+  int32_t first_inverted_hex = -1;
+
+  /// Reference comparison (meaningful only when reference_compared).
+  bool reference_compared = false;
+  /// Every boundary quad of the reference is planar (then geometry must be preserved).
+  bool reference_planar_faced = false;
+  double reference_volume = 0.0, reference_boundary_area = 0.0;
+  /// |volume - reference| / |reference| (0 if both are 0); the same for the boundary area.
+  double volume_relative_error = 0.0, boundary_area_relative_error = 0.0;
+  /// False only if the reference is planar-faced and an error exceeds the tolerance.
+  bool geometry_preserved = true;
+
+  /// conformal, no inverted hex, geometry preserved (if compared).
+  bool valid() const { return conformal && inverted_hexes == 0 && geometry_preserved; }
+};
+
+/// Checks `mesh` (and compares it with `reference`, the mesh before refinement, if given).
+/// Throws InputError naming the hex if a node id is out of range or repeated within a hex.
+MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference = nullptr);
+
+/// All fields of the report under their own names, plus "valid".
+nlohmann::json mesh_check_to_json(const MeshCheckReport& report);
+
+/// One line per defect found ("76 inverted hexes, first at id 3"), empty if none.
+std::vector<std::string> mesh_check_defects(const MeshCheckReport& report);
+
+}  // namespace hexrefine

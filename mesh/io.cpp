@@ -1,0 +1,167 @@
+#include "mesh/io.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "mesh/error.hpp"
+#include "mesh/io_text.hpp"
+#include "mesh/topology.hpp"
+
+namespace hexrefine {
+
+namespace io_detail {
+
+std::string file_read_all(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open for reading (missing or not readable)");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw InputError(path + ": read failed");
+  return std::move(ss).str();
+}
+
+int64_t IdIndex::build(const std::vector<int64_t>& ids) {
+  int64_t max_id = 0;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    if (ids[i] < 1) return static_cast<int64_t>(i);
+    max_id = std::max(max_id, ids[i]);
+  }
+  is_dense_ = max_id <= 4 * static_cast<int64_t>(ids.size()) + 1024;
+  if (is_dense_) {
+    dense_.assign(static_cast<size_t>(max_id) + 1, -1);
+    for (size_t i = 0; i < ids.size(); ++i) {
+      int32_t& slot = dense_[static_cast<size_t>(ids[i])];
+      if (slot >= 0) return static_cast<int64_t>(i);
+      slot = static_cast<int32_t>(i);
+    }
+    return -1;
+  }
+  sorted_.resize(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i) sorted_[i] = {ids[i], static_cast<int32_t>(i)};
+  std::sort(sorted_.begin(), sorted_.end());
+  for (size_t i = 1; i < sorted_.size(); ++i)
+    if (sorted_[i].first == sorted_[i - 1].first)
+      return std::max(sorted_[i].second, sorted_[i - 1].second);
+  return -1;
+}
+
+int64_t IdIndex::find(int64_t id) const {
+  if (is_dense_) {
+    if (id < 0 || id >= static_cast<int64_t>(dense_.size())) return -1;
+    return dense_[static_cast<size_t>(id)];
+  }
+  const auto it = std::lower_bound(sorted_.begin(), sorted_.end(), std::make_pair(id, INT32_MIN));
+  if (it == sorted_.end() || it->first != id) return -1;
+  return it->second;
+}
+
+void mesh_check_read(const HexMesh& mesh, const std::string& path) {
+  mesh_validate_ids(mesh, path);
+  const HexTopology t = topology_build(mesh);
+  if (!t.nonmanifold_faces.empty()) {
+    const auto& f = t.face_nodes[t.nonmanifold_faces[0]];
+    throw InputError(path + ": non-manifold mesh: face with nodes " + std::to_string(f[0]) + " " +
+                     std::to_string(f[1]) + " " + std::to_string(f[2]) + " " +
+                     std::to_string(f[3]) + " (0-based) is shared by more than two hexes (" +
+                     std::to_string(t.nonmanifold_faces.size()) + " such faces)");
+  }
+}
+
+std::string real_text(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+}  // namespace io_detail
+
+namespace {
+
+std::string extension_of(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot);
+  for (char& c : ext) c = io_detail::TextCursor::lower(c);
+  return ext;
+}
+
+/// Names travel inside VTK headers, XML attributes and Gmsh strings: keep them to one safe word.
+void name_check(const std::string& path, const std::string& name) {
+  bool ok = !name.empty() && name.size() <= 64;
+  for (char c : name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ||
+          c == '+'))
+      ok = false;
+  if (!ok)
+    throw InputError(path + ": cannot write field name '" + name +
+                     "': use 1-64 letters, digits, '_', '-', '.' or '+'");
+}
+
+}  // namespace
+
+MeshFormat mesh_format_of(const std::string& path) {
+  const std::string ext = extension_of(path);
+  if (ext == ".mesh") return MeshFormat::medit;
+  if (ext == ".vtk") return MeshFormat::vtk_legacy;
+  if (ext == ".vtu") return MeshFormat::vtu;
+  if (ext == ".msh") return MeshFormat::gmsh;
+  if (ext == ".e" || ext == ".exo") return MeshFormat::exodus;
+  if (ext == ".inp") return MeshFormat::abaqus;
+  throw InputError(path +
+                   ": unknown mesh format (expected extension .mesh, .vtk, .vtu, .msh, .e, .exo "
+                   "or .inp)");
+}
+
+HexMesh mesh_read(const std::string& path) {
+  switch (mesh_format_of(path)) {
+    case MeshFormat::medit:
+      return io_detail::medit_read(path);
+    case MeshFormat::vtk_legacy:
+      return io_detail::vtk_read(path);
+    case MeshFormat::vtu:
+      return io_detail::vtu_read(path);
+    case MeshFormat::gmsh:
+      return io_detail::gmsh_read(path);
+    case MeshFormat::exodus:
+      return io_detail::exodus_read(path);
+    case MeshFormat::abaqus:
+      return io_detail::abaqus_read(path);
+  }
+  throw InputError(path + ": unknown mesh format");
+}
+
+void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOptions& options) {
+  const MeshFormat format = mesh_format_of(path);
+  mesh_validate_ids(mesh, "mesh to write to " + path);
+  for (size_t i = 0; i < mesh.points.size(); ++i)
+    if (!mesh.points[i].allFinite())
+      throw InputError(path + ": cannot write node " + std::to_string(i) +
+                       ": coordinate is NaN or infinite");
+  for (const HexAttribute& a : mesh.attributes) name_check(path, a.name);
+  for (const auto& [name, values] : options.cell_scalars) {
+    name_check(path, name);
+    if (values.size() != mesh.hexes.size())
+      throw InputError(path + ": cell field '" + name + "' has " + std::to_string(values.size()) +
+                       " values for " + std::to_string(mesh.hexes.size()) + " hexes");
+  }
+  switch (format) {
+    case MeshFormat::medit:
+      return io_detail::medit_write(path, mesh);
+    case MeshFormat::vtk_legacy:
+      return io_detail::vtk_write(path, mesh, options.binary, options.cell_scalars);
+    case MeshFormat::vtu:
+      return io_detail::vtu_write(path, mesh, options.cell_scalars);
+    case MeshFormat::gmsh:
+      return io_detail::gmsh_write(path, mesh, options.cell_scalars);
+    case MeshFormat::exodus:
+      return io_detail::exodus_write(path, mesh);
+    case MeshFormat::abaqus:
+      return io_detail::abaqus_write(path, mesh);
+  }
+}
+
+}  // namespace hexrefine

@@ -1,0 +1,69 @@
+#pragma once
+/// \file
+/// Reading and writing hex meshes: MEDIT (.mesh), VTK legacy (.vtk, ASCII or BINARY), VTK XML
+/// unstructured grid (.vtu), Gmsh (.msh: 4.1 read and write, 2.2 read, ASCII only), Exodus II
+/// (.e, .exo) and Abaqus input (.inp). The format is chosen by the file extension.
+///
+/// Vertex order: all six formats store a linear hexahedron in the order of hex_convention.hpp
+/// (0-3 one face counter-clockwise, 4-7 the opposite face with 4 above 0): VTK_HEXAHEDRON, Exodus
+/// HEX8, Gmsh type 5, Abaqus C3D8 and MEDIT Hexahedra all agree, so no reordering is needed. The
+/// one exception is VTK_VOXEL (type 11, read only), whose nodes 2/3 and 6/7 are swapped; the VTK
+/// reader reorders it into a hex.
+///
+/// Elements that are not hexes: surface, line and point elements (boundary annotations such as
+/// MEDIT Quadrilaterals, Gmsh surface entities, VTK quads) are skipped silently; volume elements
+/// that are not linear hexes (tetrahedra, prisms, pyramids, 20/27-node hexes, polyhedra) are
+/// refused with an InputError naming the element, because dropping them would silently give a
+/// mesh with holes.
+///
+/// Per-hex attributes (HexMesh::attributes):
+/// - VTK legacy, VTU: every attribute as an int cell-data array; on reading, every
+///   single-component integer cell array becomes an attribute (float arrays are skipped).
+/// - MEDIT: the hex reference tag is block_id (0 when the mesh has none).
+/// - Gmsh 4.1: block_id > 0 is the physical tag of the hex's volume entity; every attribute
+///   (block_id included, so zero and negative ids survive) is also written as an $ElementData
+///   field. On reading, block_id comes from the physical tag (0 without one) and is overridden by
+///   an $ElementData field of that name; every single-component $ElementData field whose values
+///   are all integers becomes an attribute.
+/// - Exodus II: one element block per block_id (id 1 when the mesh has no block_id). Hexes keep
+///   their order through the element id map (written as hex index + 1; when a file's element ids
+///   are a permutation of 1..n the reader orders hexes by id).
+/// - Abaqus: one `*ELSET, ELSET=BLOCK_<id>` per block_id; on reading, elsets named
+///   `BLOCK_<integer>` (any case) give block_id, other hexes get 0.
+/// Other attributes are dropped by MEDIT, Exodus and Abaqus.
+///
+/// Every reader calls mesh_validate_ids, refuses faces shared by more than two hexes, NaN or
+/// infinite coordinates, counts that the file is too small to hold (checked before allocating),
+/// and names the file and line (or entity) in its InputError.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mesh/hex_mesh.hpp"
+
+namespace hexrefine {
+
+enum class MeshFormat { medit, vtk_legacy, vtu, gmsh, exodus, abaqus };
+
+/// Format from the extension (case-insensitive): .mesh .vtk .vtu .msh .e/.exo .inp; InputError
+/// naming the path otherwise.
+MeshFormat mesh_format_of(const std::string& path);
+
+struct MeshWriteOptions {
+  bool binary = false;  ///< VTK legacy: BINARY instead of ASCII
+  /// Extra per-hex double fields (e.g. "scaled_jacobian"), written as cell data where the format
+  /// has it (VTK, VTU; Gmsh as $ElementData). Each needs hex_count() values.
+  std::vector<std::pair<std::string, std::vector<double>>> cell_scalars;
+};
+
+/// Reads a hex mesh; the format follows from the extension. Throws InputError
+/// "path:line: what was expected" on bad input.
+HexMesh mesh_read(const std::string& path);
+
+/// Writes `mesh` atomically (temporary file + rename). Throws InputError for a mesh the format
+/// cannot hold (e.g. a bad attribute name), OperationError if the file cannot be written.
+/// ASCII formats print 17 significant digits, so coordinates read back exactly.
+void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOptions& options = {});
+
+}  // namespace hexrefine

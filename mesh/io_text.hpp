@@ -1,0 +1,266 @@
+#pragma once
+/// \file
+/// Private to the mesh readers: a whole-file buffer with a line-counting tokenizer, number parsing
+/// that refuses garbage, NaN and infinity, and size checks made before anything is allocated.
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mesh/error.hpp"
+#include "mesh/hex_mesh.hpp"
+
+namespace hexrefine::io_detail {
+
+/// The whole file as bytes; InputError naming the path if it cannot be opened or read.
+std::string file_read_all(const std::string& path);
+
+/// Tokens separated by white space (and by `extra_separators`, e.g. "," for Abaqus); `comment`
+/// (if not 0) starts a comment running to the end of the line. Tracks the 1-based line number
+/// of the last token for error messages. The text is borrowed: it must outlive the cursor.
+class TextCursor {
+ public:
+  TextCursor(const std::string& path, std::string_view text, char comment = 0,
+             const char* extra_separators = "")
+      : path_(path), text_(text), comment_(comment), extra_(extra_separators) {}
+
+  const std::string& path() const { return path_; }
+  /// For a cursor over a slice of a file: the line number of the slice's first byte.
+  void set_line(int64_t line) { line_ = line; }
+  int64_t line() const { return line_; }
+  size_t position() const { return pos_; }
+  /// Bytes not yet consumed.
+  size_t remaining() const { return text_.size() - pos_; }
+
+  /// Throws InputError "path:line: message".
+  [[noreturn]] void fail(const std::string& message) const {
+    throw InputError(error_at(path_, line_, message));
+  }
+
+  /// True when only white space and comments remain.
+  bool at_end() {
+    skip_space();
+    return pos_ >= text_.size();
+  }
+
+  /// The next token; at the end of the file fails with "unexpected end of file, expected <what>".
+  std::string_view token(const std::string& what) {
+    skip_space();
+    if (pos_ >= text_.size()) fail("unexpected end of file, expected " + what);
+    const size_t start = pos_;
+    while (pos_ < text_.size() && !is_space(text_[pos_]) && !is_extra(text_[pos_]) &&
+           text_[pos_] != comment_)
+      ++pos_;
+    return text_.substr(start, pos_ - start);
+  }
+
+  /// The next token without consuming it (empty at the end).
+  std::string_view peek() {
+    const size_t pos = pos_;
+    const int64_t line = line_;
+    skip_space();
+    if (pos_ >= text_.size()) {
+      pos_ = pos, line_ = line;
+      return {};
+    }
+    const std::string_view t = token("");
+    pos_ = pos, line_ = line;
+    return t;
+  }
+
+  /// An integer token; fails naming `what` on anything else.
+  int64_t integer(const std::string& what) {
+    const std::string_view t = token(what);
+    int64_t v = 0;
+    if (!parse_integer(t, v)) fail("expected " + what + " (an integer), got '" + shown(t) + "'");
+    return v;
+  }
+
+  /// An integer in [lo, hi].
+  int64_t integer_in(const std::string& what, int64_t lo, int64_t hi) {
+    const int64_t v = integer(what);
+    if (v < lo || v > hi)
+      fail("expected " + what + " in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
+           std::to_string(v));
+    return v;
+  }
+
+  /// A finite real token.
+  double real(const std::string& what) {
+    const std::string_view t = token(what);
+    double v = 0;
+    if (!parse_real(t, v)) fail("expected " + what + " (a finite number), got '" + shown(t) + "'");
+    return v;
+  }
+
+  /// Consumes the next token and fails unless it equals `word` (case-insensitive).
+  void expect(std::string_view word) {
+    std::string quoted(1, '\'');
+    quoted.append(word);
+    quoted.push_back('\'');
+    const std::string_view t = token(quoted);
+    if (!same_word(t, word)) fail("expected " + quoted + ", got '" + shown(t) + "'");
+  }
+
+  /// A count in [0, limit] whose items need at least `min_bytes_each` bytes of what remains of
+  /// the file; checked before the caller allocates anything.
+  int64_t count(const std::string& what, int64_t min_bytes_each, int64_t limit = INT32_MAX) {
+    const int64_t n = integer(what);
+    check_count(n, what, min_bytes_each, limit);
+    return n;
+  }
+
+  void check_count(int64_t n, const std::string& what, int64_t min_bytes_each,
+                   int64_t limit = INT32_MAX) const {
+    if (n < 0) fail("expected " + what + " >= 0, got " + std::to_string(n));
+    if (n > limit)
+      fail(what + " " + std::to_string(n) + " exceeds the limit " + std::to_string(limit));
+    if (min_bytes_each > 0 && n > static_cast<int64_t>(remaining()) / min_bytes_each)
+      fail(what + " " + std::to_string(n) + " is more than the rest of the file (" +
+           std::to_string(remaining()) + " bytes) can hold");
+  }
+
+  /// Skips the rest of the current line, including its newline.
+  void skip_line() {
+    while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+    if (pos_ < text_.size()) ++pos_, ++line_;
+  }
+
+  /// The rest of the current line (without the newline), consumed.
+  std::string_view rest_of_line() {
+    const size_t start = pos_;
+    while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+    std::string_view s = text_.substr(start, pos_ - start);
+    if (pos_ < text_.size()) ++pos_, ++line_;
+    if (!s.empty() && s.back() == '\r') s.remove_suffix(1);
+    return s;
+  }
+
+  /// `n` raw bytes (for binary blocks), consumed; fails naming `what` if the file is shorter.
+  const char* raw(size_t n, const std::string& what) {
+    if (n > remaining())
+      fail("file ends inside " + what + " (" + std::to_string(n) + " bytes expected, " +
+           std::to_string(remaining()) + " left)");
+    const char* p = text_.data() + pos_;
+    for (size_t i = 0; i < n; ++i)
+      if (p[i] == '\n') ++line_;
+    pos_ += n;
+    return p;
+  }
+
+  static bool parse_integer(std::string_view t, int64_t& v) {
+    if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    return !t.empty() && r.ec == std::errc() && r.ptr == t.data() + t.size();
+  }
+  static bool parse_real(std::string_view t, double& v) {
+    if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    return !t.empty() && r.ec == std::errc() && r.ptr == t.data() + t.size() && std::isfinite(v);
+  }
+  static bool same_word(std::string_view a, std::string_view b) {
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i)
+      if (lower(a[i]) != lower(b[i])) return false;
+    return true;
+  }
+  static char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c + 32) : c; }
+  /// A token made safe to print: at most 40 characters, non-printable bytes as '?'.
+  static std::string shown(std::string_view t) {
+    std::string s(t.substr(0, 40));
+    for (char& c : s)
+      if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+    if (t.size() > 40) s += "...";
+    return s;
+  }
+
+ private:
+  static bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
+  }
+  bool is_extra(char c) const { return c != 0 && std::strchr(extra_, c) != nullptr; }
+  void skip_space() {
+    while (pos_ < text_.size()) {
+      const char c = text_[pos_];
+      if (c == '\n') {
+        ++line_, ++pos_;
+      } else if (is_space(c) || is_extra(c)) {
+        ++pos_;
+      } else if (comment_ != 0 && c == comment_) {
+        while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+      } else {
+        break;
+      }
+    }
+  }
+
+  std::string path_;
+  std::string_view text_;
+  char comment_;
+  const char* extra_;
+  size_t pos_ = 0;
+  int64_t line_ = 1;
+};
+
+/// Maps arbitrary positive file ids (node or element tags) to 0-based indices. Dense when the
+/// ids are compact (max id <= 4 * count + 1024), otherwise sorted pairs with binary search.
+class IdIndex {
+ public:
+  /// Builds the index; `ids[i]` is the file id of item i. Returns the position of a repeated id,
+  /// or -1 when all ids are distinct and >= 1.
+  int64_t build(const std::vector<int64_t>& ids);
+  /// Index of file id `id`, or -1.
+  int64_t find(int64_t id) const;
+
+ private:
+  std::vector<int32_t> dense_;
+  std::vector<std::pair<int64_t, int32_t>> sorted_;
+  bool is_dense_ = true;
+};
+
+/// The checks every reader ends with: ids in range and distinct per hex (mesh_validate_ids), no
+/// face shared by more than two hexes (message names the face's nodes, 0-based).
+void mesh_check_read(const HexMesh& mesh, const std::string& path);
+
+/// Prints a double with 17 significant digits (round-trips exactly).
+std::string real_text(double v);
+
+/// Appends `v` in big-endian byte order (VTK legacy binary).
+template <class T>
+void append_big_endian(std::string& out, T v) {
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  for (size_t i = 0; i < sizeof(T); ++i) out.push_back(b[sizeof(T) - 1 - i]);
+}
+/// Reads a big-endian value from `p`.
+template <class T>
+T read_big_endian(const char* p) {
+  char b[sizeof(T)];
+  for (size_t i = 0; i < sizeof(T); ++i) b[i] = p[sizeof(T) - 1 - i];
+  T v;
+  std::memcpy(&v, b, sizeof(T));
+  return v;
+}
+
+// Per-format entry points (io_<format>.cpp); mesh_read / mesh_write dispatch to them.
+HexMesh medit_read(const std::string& path);
+void medit_write(const std::string& path, const HexMesh& mesh);
+HexMesh vtk_read(const std::string& path);
+void vtk_write(const std::string& path, const HexMesh& mesh, const bool binary,
+               const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
+HexMesh vtu_read(const std::string& path);
+void vtu_write(const std::string& path, const HexMesh& mesh,
+               const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
+HexMesh gmsh_read(const std::string& path);
+void gmsh_write(const std::string& path, const HexMesh& mesh,
+                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
+HexMesh exodus_read(const std::string& path);
+void exodus_write(const std::string& path, const HexMesh& mesh);
+HexMesh abaqus_read(const std::string& path);
+void abaqus_write(const std::string& path, const HexMesh& mesh);
+
+}  // namespace hexrefine::io_detail

@@ -1,0 +1,49 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "cli_runner.hpp"
+#include "mesh/io.hpp"
+
+namespace hexrefine {
+namespace {
+
+TEST(CliConvert, ConvertsSharedMeshToEveryFormat) {
+  const auto dir = test_temp_dir("cli_convert_all");
+  for (const char* ext : {".vtk", ".vtu", ".msh", ".e", ".inp", ".mesh"}) {
+    const std::string out = (dir / (std::string("rocker") + ext)).string();
+    const CliRun r = cli_run("convert " + shared_mesh("rockerarm.mesh") + " " + out);
+    ASSERT_EQ(r.exit_code, 0) << ext << ": " << r.output;
+    EXPECT_NE(r.output.find("10600 hexes"), std::string::npos) << r.output;
+    EXPECT_EQ(mesh_read(out).hex_count(), 10600) << ext;
+  }
+  const std::string bin = (dir / "rocker_bin.vtk").string();
+  const CliRun r = cli_run("convert " + shared_mesh("rockerarm.mesh") + " " + bin + " --binary");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(mesh_read(bin).hex_count(), 10600);
+}
+
+TEST(CliConvert, BadInputExitsTwoNamingTheFile) {
+  const auto dir = test_temp_dir("cli_convert_bad");
+  const auto bad = dir / "broken.mesh";
+  std::ofstream(bad) << "MeshVersionFormatted 1\nDimension 3\nVertices\n2\n0 0 0 0\n";
+  const std::string out = (dir / "out.vtk").string();
+  CliRun r = cli_run("convert " + bad.string() + " " + out);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("broken.mesh"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  r = cli_run("convert " + shared_mesh("sphere_conforming.mesh") + " " + (dir / "x.stl").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("x.stl"), std::string::npos) << r.output;
+  r = cli_run("convert " + shared_mesh("sphere_conforming.mesh"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = cli_run("convert " + shared_mesh("sphere_conforming.mesh") + " " + (dir / "x.msh").string() +
+              " --binary");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = cli_run("convert " + (dir / "missing.mesh").string() + " " + out);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("missing.mesh"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace hexrefine

@@ -1,0 +1,241 @@
+#include "mesh/conformity.hpp"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "mesh/error.hpp"
+#include "mesh/hex_convention.hpp"
+#include "tests/fixtures.hpp"
+
+namespace hexrefine {
+namespace {
+
+/// Axis-aligned boxes (lo, hi) as hexes; nodes at equal coordinates are merged.
+HexMesh mesh_from_boxes(const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& boxes) {
+  HexMesh m;
+  std::map<std::array<double, 3>, int32_t> ids;
+  for (const auto& [lo, hi] : boxes) {
+    HexCell c;
+    for (int v = 0; v < 8; ++v) {
+      std::array<double, 3> x;
+      for (int k = 0; k < 3; ++k) x[k] = hex_corner[v][k] ? hi[k] : lo[k];
+      const auto [it, added] = ids.try_emplace(x, m.point_count());
+      if (added) m.points.emplace_back(x[0], x[1], x[2]);
+      c[v] = it->second;
+    }
+    m.hexes.push_back(c);
+  }
+  return m;
+}
+
+/// 2x1x1 brick whose hex at x in [1,2] is replaced by its 1-8 octree split.
+HexMesh brick_with_one_octree_split() {
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> boxes = {
+      {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1)}};
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) {
+        const Eigen::Vector3d lo(1 + 0.5 * i, 0.5 * j, 0.5 * k);
+        boxes.push_back({lo, lo + Eigen::Vector3d::Constant(0.5)});
+      }
+  return mesh_from_boxes(boxes);
+}
+
+TEST(Conformity, BrickIsClean) {
+  const HexMesh m = fixture_brick(3, 2, 2);
+  const MeshCheckReport r = mesh_check(m);
+  EXPECT_EQ(r.hexes, 12);
+  EXPECT_EQ(r.nodes, 36);
+  EXPECT_TRUE(r.conformal);
+  EXPECT_TRUE(r.valid());
+  EXPECT_EQ(r.non_conformal_faces, 0);
+  EXPECT_EQ(r.hanging_nodes, 0);
+  EXPECT_EQ(r.inverted_hexes, 0);
+  EXPECT_EQ(r.first_inverted_hex, -1);
+  EXPECT_EQ(r.doublets, 0);
+  EXPECT_EQ(r.nonmanifold_faces, 0);
+  EXPECT_EQ(r.nonmanifold_boundary_edges, 0);
+  EXPECT_EQ(r.duplicate_nodes, 0);
+  EXPECT_EQ(r.unused_nodes, 0);
+  EXPECT_EQ(r.boundary_faces, 2 * (3 * 2 + 3 * 2 + 2 * 2));
+  EXPECT_DOUBLE_EQ(r.min_scaled_jacobian, 1.0);
+  EXPECT_DOUBLE_EQ(r.mean_scaled_jacobian, 1.0);
+  EXPECT_NEAR(r.volume, 12.0, 1e-12);
+  EXPECT_NEAR(r.boundary_area, 32.0, 1e-12);
+  EXPECT_FALSE(r.reference_compared);
+}
+
+TEST(Conformity, TwoHexesSharingTwoFacesAreADoublet) {
+  HexMesh m = fixture_brick(1, 1, 1);
+  m.points.emplace_back(-1, -1, 0);  // 8
+  m.points.emplace_back(-1, -1, 1);  // 9
+  // Brick node ids run x fastest: hex 0 is {0,1,3,2,4,5,7,6}. The new hex shares hex 0's +x face
+  // {1,3,7,5} (as its -x face) and +y face {2,6,7,3} (as its -y face).
+  m.hexes.push_back({3, 2, 8, 1, 7, 6, 9, 5});
+  const MeshCheckReport r = mesh_check(m);
+  EXPECT_EQ(r.doublets, 1);
+  EXPECT_EQ(r.nonmanifold_faces, 0);
+  EXPECT_FALSE(r.conformal);
+  EXPECT_FALSE(r.valid());
+}
+
+TEST(Conformity, OctreeSplitBesideUnsplitHexIsNonConformal) {
+  const HexMesh m = brick_with_one_octree_split();
+  ASSERT_EQ(m.hex_count(), 9);
+  ASSERT_EQ(m.point_count(), 31);
+  const HexMesh reference = fixture_brick(2, 1, 1);
+  for (const HexMesh* ref : {static_cast<const HexMesh*>(nullptr), &reference}) {
+    const MeshCheckReport r = mesh_check(m, ref);
+    SCOPED_TRACE(ref ? "with reference" : "without reference");
+    // The unsplit hex's +x face and the four small faces behind it.
+    EXPECT_EQ(r.non_conformal_faces, 5);
+    // Four edge midpoints and the face centre of the interface.
+    EXPECT_EQ(r.hanging_nodes, 5);
+    EXPECT_EQ(r.boundary_faces, 6 + 24);
+    EXPECT_EQ(r.nonmanifold_boundary_edges, 0);  // two sheets touching: still a closed surface
+    EXPECT_EQ(r.doublets, 0);
+    EXPECT_EQ(r.inverted_hexes, 0);
+    EXPECT_FALSE(r.conformal);
+    EXPECT_NEAR(r.volume, 2.0, 1e-12);
+    EXPECT_NEAR(r.boundary_area, 12.0, 1e-12);  // the interface counted from both sides
+  }
+  const MeshCheckReport r = mesh_check(m, &reference);
+  EXPECT_TRUE(r.reference_compared);
+  EXPECT_TRUE(r.reference_planar_faced);
+  EXPECT_NEAR(r.volume_relative_error, 0.0, 1e-15);
+  EXPECT_NEAR(r.boundary_area_relative_error, 0.2, 1e-12);
+  EXPECT_FALSE(r.geometry_preserved);
+}
+
+TEST(Conformity, ConformingOctreeSplitMatchesReference) {
+  // Whole 1x1x1 reference split 2x2x2: conformal, geometry preserved exactly.
+  const HexMesh reference = fixture_brick(1, 1, 1);
+  const HexMesh m = fixture_brick(2, 2, 2, 0.5);
+  const MeshCheckReport r = mesh_check(m, &reference);
+  EXPECT_TRUE(r.conformal);
+  EXPECT_TRUE(r.valid());
+  EXPECT_EQ(r.non_conformal_faces, 0);
+  EXPECT_TRUE(r.reference_planar_faced);
+  EXPECT_LT(r.volume_relative_error, 1e-15);
+  EXPECT_LT(r.boundary_area_relative_error, 1e-15);
+  EXPECT_TRUE(r.geometry_preserved);
+  EXPECT_DOUBLE_EQ(r.reference_volume, 1.0);
+  EXPECT_DOUBLE_EQ(r.reference_boundary_area, 6.0);
+}
+
+TEST(Conformity, BoundaryNodeMovedOffReferenceSurface) {
+  const HexMesh reference = fixture_brick(1, 1, 1);
+  HexMesh m = fixture_brick(2, 2, 2, 0.5);
+  // Centre node of the x = 1 face (i=2, j=1, k=1 in the 3x3x3 node grid) pushed outward.
+  const int32_t centre = 2 + 3 * (1 + 3 * 1);
+  ASSERT_DOUBLE_EQ(m.points[centre].x(), 1.0);
+  m.points[centre].x() = 1.1;
+  const MeshCheckReport r = mesh_check(m, &reference);
+  EXPECT_EQ(r.non_conformal_faces, 4);  // the four faces around the moved node
+  EXPECT_EQ(r.hanging_nodes, 0);
+  EXPECT_FALSE(r.conformal);
+  // Each of the four 0.5 x 0.5 faces bulges by 0.1 at one corner: 4 x 0.1 x 0.25 / 4.
+  EXPECT_NEAR(r.volume_relative_error, 0.025, 1e-12);
+  EXPECT_GT(r.boundary_area_relative_error, 1e-4);
+  EXPECT_FALSE(r.geometry_preserved);
+  EXPECT_FALSE(r.valid());
+  // Without a reference the bulge is indistinguishable from true boundary.
+  EXPECT_TRUE(mesh_check(m).conformal);
+}
+
+TEST(Conformity, NonPlanarReferenceOnlyReportsGeometryErrors) {
+  HexMesh reference = fixture_brick(1, 1, 1);
+  reference.points[6].z() = 1.2;  // warps the top, +x and +y faces
+  HexMesh m = fixture_brick(1, 1, 1);
+  m.points[6].z() = 1.3;
+  const MeshCheckReport r = mesh_check(m, &reference);
+  EXPECT_FALSE(r.reference_planar_faced);
+  EXPECT_GT(r.volume_relative_error, 1e-3);
+  EXPECT_TRUE(r.geometry_preserved);
+  EXPECT_EQ(r.non_conformal_faces, 3);  // the three faces at the moved corner leave the surface
+}
+
+TEST(Conformity, FaceSharedByThreeHexes) {
+  HexMesh m = fixture_brick(1, 1, 2);  // hexes 0 and 1 share the face z = 1, nodes {4, 5, 7, 6}
+  for (int v = 4; v < 8; ++v) m.points.emplace_back(m.points[v] + Eigen::Vector3d(0.3, 0, 2));
+  m.hexes.push_back({4, 5, 7, 6, 12, 13, 15, 14});  // a third hex on that face
+  const MeshCheckReport r = mesh_check(m);
+  EXPECT_EQ(r.nonmanifold_faces, 1);
+  EXPECT_EQ(r.doublets, 0);
+  EXPECT_FALSE(r.conformal);
+  EXPECT_EQ(r.inverted_hexes, 0);
+}
+
+TEST(Conformity, InvertedHexIsCountedAndLocated) {
+  HexMesh m = fixture_brick(3, 1, 1);
+  HexCell& c = m.hexes[1];
+  for (int v = 0; v < 4; ++v) std::swap(c[v], c[v + 4]);  // inside out
+  const MeshCheckReport r = mesh_check(m);
+  EXPECT_EQ(r.inverted_hexes, 1);
+  EXPECT_EQ(r.first_inverted_hex, 1);
+  EXPECT_DOUBLE_EQ(r.min_scaled_jacobian, -1.0);
+  EXPECT_NEAR(r.mean_scaled_jacobian, 1.0 / 3.0, 1e-15);
+  EXPECT_TRUE(r.conformal);  // same faces, only the orientation is wrong
+  EXPECT_FALSE(r.valid());
+  EXPECT_NEAR(r.volume, 1.0, 1e-12);  // 1 + (-1) + 1
+  const std::vector<std::string> defects = mesh_check_defects(r);
+  ASSERT_EQ(defects.size(), 1u);
+  EXPECT_EQ(defects[0], "1 inverted hexes, first at id 1");
+}
+
+TEST(Conformity, DuplicateAndUnusedNodes) {
+  HexMesh m = fixture_brick(1, 1, 1);
+  m.points.emplace_back(0, 0, 0);          // duplicate of node 0, unused
+  m.points.emplace_back(5, 5, 5);          // unused
+  m.points.emplace_back(1, 1, 1 + 1e-14);  // duplicate of node 6 within 1e-12 x diagonal, unused
+  const MeshCheckReport r = mesh_check(m);
+  EXPECT_EQ(r.duplicate_nodes, 2);
+  EXPECT_EQ(r.unused_nodes, 3);
+  EXPECT_TRUE(r.conformal);  // loose nodes do not break conformity
+}
+
+TEST(Conformity, CrackOfDuplicatedNodesLeavesCoincidentFaces) {
+  HexMesh m = fixture_brick(2, 1, 1);
+  // Hex 1 gets its own copies of the four nodes on x = 1.
+  for (int v : {0, 3, 4, 7}) {
+    m.points.push_back(m.points[m.hexes[1][v]]);
+    m.hexes[1][v] = m.point_count() - 1;
+  }
+  const MeshCheckReport r = mesh_check(m);
+  EXPECT_EQ(r.duplicate_nodes, 4);
+  EXPECT_EQ(r.non_conformal_faces, 2);
+  EXPECT_EQ(r.hanging_nodes, 0);  // coincident corners are duplicates, not T-junctions
+  EXPECT_FALSE(r.conformal);
+}
+
+TEST(Conformity, RefusesBadIds) {
+  HexMesh m = fixture_brick(1, 1, 1);
+  m.hexes[0][3] = 99;
+  EXPECT_THROW(mesh_check(m), InputError);
+}
+
+TEST(Conformity, EmptyMesh) {
+  const MeshCheckReport r = mesh_check(HexMesh{});
+  EXPECT_EQ(r.hexes, 0);
+  EXPECT_TRUE(r.conformal);
+  EXPECT_DOUBLE_EQ(r.min_scaled_jacobian, 1.0);
+}
+
+TEST(Conformity, JsonCarriesEveryCount) {
+  const MeshCheckReport r = mesh_check(brick_with_one_octree_split(), nullptr);
+  const nlohmann::json j = mesh_check_to_json(r);
+  EXPECT_EQ(j["hexes"], 9);
+  EXPECT_EQ(j["non_conformal_faces"], 5);
+  EXPECT_EQ(j["hanging_nodes"], 5);
+  EXPECT_EQ(j["conformal"], false);
+  EXPECT_EQ(j["valid"], false);
+  for (const char* key : {"nodes", "inverted_hexes", "doublets", "nonmanifold_faces",
+                          "nonmanifold_boundary_edges", "duplicate_nodes", "unused_nodes",
+                          "boundary_faces", "min_scaled_jacobian", "mean_scaled_jacobian", "volume",
+                          "boundary_area", "first_inverted_hex", "reference_compared"})
+    EXPECT_TRUE(j.contains(key)) << key;
+}
+
+}  // namespace
+}  // namespace hexrefine

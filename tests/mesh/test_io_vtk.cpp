@@ -1,0 +1,123 @@
+#include <gtest/gtest.h>
+
+#include "cli_runner.hpp"
+#include "io_test_support.hpp"
+#include "mesh/error.hpp"
+#include "mesh/io.hpp"
+
+namespace hexrefine {
+namespace {
+
+MeshWriteOptions io_options_with_scalar(const HexMesh& m, bool binary) {
+  MeshWriteOptions o;
+  o.binary = binary;
+  std::vector<double> q(m.hexes.size());
+  for (size_t h = 0; h < q.size(); ++h) q[h] = 1.0 / (1.0 + static_cast<double>(h));
+  o.cell_scalars.emplace_back("scaled_jacobian", q);
+  return o;
+}
+
+TEST(IoVtk, AsciiRoundTripKeepsEverything) {
+  const auto dir = test_temp_dir("io_vtk_ascii");
+  const HexMesh m = io_test_brick();
+  const std::string path = (dir / "brick.vtk").string();
+  mesh_write(path, m, io_options_with_scalar(m, false));
+  const HexMesh r = mesh_read(path);
+  io_expect_same_geometry(m, r, 1e-12);
+  io_expect_same_geometry(m, r, 0);
+  ASSERT_EQ(r.attributes.size(), 3u);  // the double field is not an integer attribute
+  for (const HexAttribute& a : m.attributes) io_expect_same_attribute(m, r, a.name);
+}
+
+TEST(IoVtk, BinaryRoundTripIsExact) {
+  const auto dir = test_temp_dir("io_vtk_binary");
+  const HexMesh m = io_test_brick();
+  const std::string path = (dir / "brick.vtk").string();
+  mesh_write(path, m, io_options_with_scalar(m, true));
+  const HexMesh r = mesh_read(path);
+  io_expect_same_geometry(m, r, 0);
+  ASSERT_EQ(r.attributes.size(), 3u);
+  for (const HexAttribute& a : m.attributes) io_expect_same_attribute(m, r, a.name);
+}
+
+TEST(IoVtk, ReadsNewLayoutSkipsQuadsAndReordersVoxels) {
+  const auto dir = test_temp_dir("io_vtk_layout");
+  const auto p = dir / "mixed.vtk";
+  std::string pts;
+  for (int i = 0; i < 12; ++i)
+    pts += std::to_string(i % 3) + " " + std::to_string((i / 3) % 2) + " " + std::to_string(i / 6) +
+           "\n";
+  // Voxel order of the cube with corners 0,1,3,4 (bottom) 6,7,9,10 (top): x fastest, then y.
+  io_write_text(p,
+                "# vtk DataFile Version 5.1\nt\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+                "POINTS 12 float\n" +
+                    pts +
+                    "CELLS 4 20\nOFFSETS vtktypeint64\n0 8 12 20\nCONNECTIVITY vtktypeint64\n"
+                    "0 1 4 3 6 7 10 9\n0 1 4 3\n1 2 4 5 7 8 10 11\n"
+                    "CELL_TYPES 3\n12\n9\n11\n"
+                    "CELL_DATA 3\nFIELD FieldData 2\nblock_id 1 3 int\n5 6 7\n"
+                    "quality 1 3 double\n0.5 nan 1\n");
+  const HexMesh r = mesh_read(p.string());
+  ASSERT_EQ(r.hex_count(), 2);
+  EXPECT_EQ(r.hexes[0], (HexCell{0, 1, 4, 3, 6, 7, 10, 9}));
+  EXPECT_EQ(r.hexes[1], (HexCell{1, 2, 5, 4, 7, 8, 11, 10}));
+  ASSERT_NE(mesh_find_attribute(r, attribute_block_id), nullptr);
+  EXPECT_EQ(*mesh_find_attribute(r, attribute_block_id), (std::vector<int32_t>{5, 7}));
+}
+
+TEST(IoVtk, RefusesTetraAndBadPointIds) {
+  const auto dir = test_temp_dir("io_vtk_bad");
+  const std::string head =
+      "# vtk DataFile Version 3.0\nt\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+      "POINTS 8 double\n0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {head + "CELLS 1 5\n4 0 1 2 4\nCELL_TYPES 1\n10\n",
+       "volume cell that is not a linear hexahedron"},
+      {head + "CELLS 1 9\n8 0 1 2 3 4 5 6 8\nCELL_TYPES 1\n12\n", "refers to point 8"},
+      {head + "CELLS 1 9\n8 0 1 2 3 4 5 6 7\nCELL_TYPES 2\n12\n12\n",
+       "differs from the CELLS count"},
+      {head + "CELLS 1 9\n8 0 1 2 3 4 5 6\n", "cell list size 9 is more than the rest"},
+      {head + "CELLS 1000000000000 9\n", "cell count 1000000000000 exceeds"},
+      {head + "CELLS 100000 900000\n8 0 1 2 3 4 5 6 7\n", "more than the rest of the file"},
+      {"# vtk DataFile Version 3.0\nt\nASCII\nDATASET STRUCTURED_POINTS\n", "UNSTRUCTURED_GRID"},
+  };
+  int i = 0;
+  for (const auto& [text, expected] : cases) {
+    const auto p = dir / ("bad" + std::to_string(i++) + ".vtk");
+    io_write_text(p, text);
+    try {
+      mesh_read(p.string());
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(IoVtu, RoundTripKeepsEverything) {
+  const auto dir = test_temp_dir("io_vtu");
+  const HexMesh m = io_test_brick();
+  const std::string path = (dir / "brick.vtu").string();
+  mesh_write(path, m, io_options_with_scalar(m, false));
+  const HexMesh r = mesh_read(path);
+  io_expect_same_geometry(m, r, 0);
+  ASSERT_EQ(r.attributes.size(), 3u);
+  for (const HexAttribute& a : m.attributes) io_expect_same_attribute(m, r, a.name);
+}
+
+TEST(IoFormat, ByExtension) {
+  EXPECT_EQ(mesh_format_of("a/b.mesh"), MeshFormat::medit);
+  EXPECT_EQ(mesh_format_of("b.VTK"), MeshFormat::vtk_legacy);
+  EXPECT_EQ(mesh_format_of("b.vtu"), MeshFormat::vtu);
+  EXPECT_EQ(mesh_format_of("b.msh"), MeshFormat::gmsh);
+  EXPECT_EQ(mesh_format_of("b.e"), MeshFormat::exodus);
+  EXPECT_EQ(mesh_format_of("b.exo"), MeshFormat::exodus);
+  EXPECT_EQ(mesh_format_of("b.inp"), MeshFormat::abaqus);
+  EXPECT_THROW(mesh_format_of("b.stl"), InputError);
+  EXPECT_THROW(mesh_format_of("dir.vtk/b"), InputError);
+  EXPECT_THROW(mesh_read("/nonexistent/x.vtk"), InputError);
+}
+
+}  // namespace
+}  // namespace hexrefine

@@ -16,29 +16,14 @@
 #include "mesh/error.hpp"
 #include "mesh/topology.hpp"
 
-// The mesh-layer pieces land on main from other branches; until each has landed the executor
-// reports the missing piece as an OperationError (an error record), so the runner's own logic
-// can be built and tested first.
-#if __has_include("mesh/generators.hpp")
-#include "mesh/generators.hpp"
-#define HEXREFINE_RUNNER_HAVE_GENERATORS 1
-#endif
-#if __has_include("mesh/selection.hpp")
-#include "mesh/selection.hpp"
-#define HEXREFINE_RUNNER_HAVE_SELECTION 1
-#endif
-#if __has_include("mesh/quality.hpp")
-#include "mesh/quality.hpp"
-#define HEXREFINE_RUNNER_HAVE_QUALITY 1
-#endif
-#if __has_include("mesh/conformity.hpp")
 #include "mesh/conformity.hpp"
-#define HEXREFINE_RUNNER_HAVE_CONFORMITY 1
-#endif
-#if __has_include("mesh/io.hpp")
+#include "mesh/generators.hpp"
 #include "mesh/io.hpp"
-#define HEXREFINE_RUNNER_HAVE_IO 1
-#endif
+#include "mesh/quality.hpp"
+#include "mesh/selection.hpp"
+
+// Smoothing lands on main from another branch; until it has, a case asking for it records
+// "smooth_error" instead of the smoothed minimum.
 #if __has_include("algorithms/smoothing.hpp")
 #include "algorithms/smoothing.hpp"
 #define HEXREFINE_RUNNER_HAVE_SMOOTHING 1
@@ -50,30 +35,19 @@ namespace {
 
 using nlohmann::json;
 
-[[noreturn]] void missing(const char* what) {
-  throw OperationError(std::string("runner: ") + what + " has not landed in this build");
-}
-
-#ifdef HEXREFINE_RUNNER_HAVE_GENERATORS
 template <typename T>
 void param_read(const json& j, const char* key, T& value) {
   if (j.contains(key)) value = j[key].get<T>();
 }
-#endif
 
 /// The case's input mesh; `input` receives the record's "input" object.
 HexMesh case_mesh(const RunCase& c, json& input) {
   if (c.mesh.contains("file")) {
     const std::string path = c.mesh["path"].get<std::string>();
     input = json{{"file", c.mesh["file"]}, {"sha256", sha256_file(path)}};
-#ifdef HEXREFINE_RUNNER_HAVE_IO
     return mesh_read(path);
-#else
-    missing("mesh/io.hpp (mesh_read)");
-#endif
   }
   input = c.mesh;
-#ifdef HEXREFINE_RUNNER_HAVE_GENERATORS
   const json& m = c.mesh;
   const std::string kind = m["generate"].get<std::string>();
   if (kind == "brick") {
@@ -128,14 +102,10 @@ HexMesh case_mesh(const RunCase& c, json& input) {
     return generate_stepped(p);
   }
   throw InputError("runner: unknown generator '" + kind + "'");
-#else
-  missing("mesh/generators.hpp");
-#endif
 }
 
-/// Minimum, mean and histogram of the scaled Jacobians of `mesh`, under `prefix`.
+/// Minimum, mean and histogram of the scaled Jacobians of `mesh`.
 void quality_measure(const HexMesh& mesh, json& fields) {
-#ifdef HEXREFINE_RUNNER_HAVE_QUALITY
   const std::vector<double> sj = mesh_scaled_jacobians(mesh);
   double min_sj = 1.0, sum = 0.0;
   for (double v : sj) {
@@ -146,36 +116,16 @@ void quality_measure(const HexMesh& mesh, json& fields) {
   fields["mean_scaled_jacobian"] = sj.empty() ? 1.0 : sum / static_cast<double>(sj.size());
   fields["scaled_jacobian_histogram"] = {
       {"bin_edges_from", -1.0}, {"bin_width", 0.1}, {"counts", scaled_jacobian_histogram(sj)}};
-#else
-  (void)mesh;
-  (void)fields;
-  missing("mesh/quality.hpp");
-#endif
-}
-
-double quality_min(const HexMesh& mesh) {
-#ifdef HEXREFINE_RUNNER_HAVE_QUALITY
-  return mesh_min_scaled_jacobian(mesh);
-#else
-  (void)mesh;
-  missing("mesh/quality.hpp");
-#endif
 }
 
 /// Conformity and validity of a refined mesh against its input.
 void check_measure(const HexMesh& out, const HexMesh& reference, json& fields) {
-#ifdef HEXREFINE_RUNNER_HAVE_CONFORMITY
-  const json check = mesh_check_to_json(mesh_check(out, &reference));
-  fields["check"] = check;
-  fields["conformal"] = check.value("conformal", false);
-  fields["non_conformal_faces"] = check.value("non_conformal_faces", int64_t{-1});
-  fields["inverted_hexes"] = check.value("inverted_hexes", int64_t{-1});
-#else
-  (void)out;
-  (void)reference;
-  (void)fields;
-  missing("mesh/conformity.hpp");
-#endif
+  const MeshCheckReport report = mesh_check(out, &reference);
+  fields["conformal"] = report.conformal;
+  fields["non_conformal_faces"] = report.non_conformal_faces;
+  fields["inverted_hexes"] = report.inverted_hexes;
+  fields["valid"] = report.valid();
+  fields["check"] = mesh_check_to_json(report);
 }
 
 RefineResult method_run(const std::string& method, const HexMesh& mesh, const Targets& targets,
@@ -190,18 +140,14 @@ RefineResult method_run(const std::string& method, const HexMesh& mesh, const Ta
 void case_execute(const RunCase& c, const std::vector<std::string>& methods, const RunEmit& emit) {
   json input;
   const HexMesh mesh = case_mesh(c, input);
-  input["initial_min_scaled_jacobian"] = quality_min(mesh);
-#ifdef HEXREFINE_RUNNER_HAVE_SELECTION
+  input["initial_min_scaled_jacobian"] = mesh_min_scaled_jacobian(mesh);
   const HexTopology topology = topology_build(mesh);
   const Selection selection = select_hexes(mesh, topology, c.select);
   Targets targets;
   targets.hexes = selection.hexes;
-#else
-  Targets targets;
-  missing("mesh/selection.hpp");
-#endif
-  const json selection_json = {{"specs", c.select_given},
-                               {"hexes", static_cast<int64_t>(targets.hexes.size())}};
+  json selection_json = {{"specs", c.select_given},
+                         {"hexes", static_cast<int64_t>(targets.hexes.size())}};
+  if (!selection.warning.empty()) selection_json["warning"] = selection.warning;
 
   for (const std::string& method : methods) {
     json fields = json::object();
@@ -240,7 +186,7 @@ void case_execute(const RunCase& c, const std::vector<std::string>& methods, con
       HexMesh smoothed = result.mesh;
       const SmoothStats smooth_stats = mesh_smooth(smoothed, SmoothOptions{});
       (void)smooth_stats;
-      fields["smoothed_min_scaled_jacobian"] = quality_min(smoothed);
+      fields["smoothed_min_scaled_jacobian"] = mesh_min_scaled_jacobian(smoothed);
 #else
       fields["smoothed_min_scaled_jacobian"] = nullptr;
       fields["smooth_error"] = "algorithms/smoothing.hpp has not landed in this build";

@@ -219,6 +219,7 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
     c.options.passes = static_cast<int>(passes);
   }
   if (j.contains("smooth")) c.smooth = schema_bool(j["smooth"], p.at("smooth"));
+  if (j.contains("save_mesh")) c.save_mesh = schema_bool(j["save_mesh"], p.at("save_mesh"));
   if (j.contains("options")) {
     const json& o = j["options"];
     const SchemaPath op = p.at("options");
@@ -560,6 +561,13 @@ std::string run_timestamp_utc() {
   return buf;
 }
 
+std::string run_mesh_file_name(const std::string& case_name, const std::string& method) {
+  std::string name = case_name;
+  for (char& ch : name)
+    if (ch == '/' || ch == '\\' || ch == ' ' || ch == ':') ch = '_';
+  return name + "." + method + ".vtu";
+}
+
 std::vector<int64_t> scaled_jacobian_histogram(const std::vector<double>& values) {
   std::vector<int64_t> bins(20, 0);
   for (double v : values) {
@@ -629,7 +637,12 @@ RunSummary run_plan_execute(const RunPlan& plan, const RunSettings& settings,
   };
   int64_t pairs_done = 0;
   for (size_t w = 0; w < work.size(); ++w) {
-    const RunCase& c = *work[w].first;
+    RunCase c = *work[w].first;
+    if (c.save_mesh) {
+      const fs::path out(output);
+      c.save_mesh_dir = (out.parent_path() / (out.stem().string() + ".meshes")).string();
+      fs::create_directories(c.save_mesh_dir, ec);
+    }
     const std::vector<std::string>& todo = work[w].second;
     if (settings.progress) {
       std::ostringstream line;

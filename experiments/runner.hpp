@@ -10,7 +10,7 @@
 ///   {"cases": [{"name": "G-1",
 ///               "mesh": {"generate": "brick", "dims": [10,10,10], "size": [1,1,1]} | {"file":
 ///               "m.mesh"}, "select": ["boundary:-1,0,0", ...], "methods": ["selective", "sheet"],
-///               "passes": 1, "smooth": false,
+///               "passes": 1, "smooth": false, "save_mesh": false,
 ///               "options": {"ranking": true, "propagation": true, "ebe_only": false,
 ///                           "buffer": false, "allow_inverted": false},
 ///               "tags": {...}}],           // optional, copied into every record
@@ -39,6 +39,9 @@ struct RunCase {
   std::vector<std::string> methods;       ///< each "selective" or "sheet", no repeats
   RefineOptions options;                  ///< passes and the "options" object
   bool smooth = false;
+  bool save_mesh = false;  ///< write each refined mesh as .vtu (for experiments/render_mesh.py)
+  /// Set by run_plan_execute when save_mesh: the folder "<output stem>.meshes" beside the output.
+  std::string save_mesh_dir;
   nlohmann::json tags = nlohmann::json::object();
 };
 
@@ -158,13 +161,17 @@ RunSummary run_plan_execute(const RunPlan& plan, const RunSettings& settings,
                             const RunExecutor& execute);
 
 /// The real executor: builds or reads the mesh, selects the targets, runs each method, checks
-/// the output (conformity, inverted hexes), measures scaled Jacobians, smooths if asked.
+/// the output (conformity, inverted hexes), measures scaled Jacobians, smooths if asked, and
+/// with save_mesh writes save_mesh_dir/run_mesh_file_name(case, method) (record: "mesh_file").
 void case_execute(const RunCase& c, const std::vector<std::string>& methods, const RunEmit& emit);
 
 /// Scaled Jacobian histogram bins: 20 bins of width 0.1 over [-1, 1]; bin b holds values in
 /// [-1 + 0.1 b, -1 + 0.1 (b + 1)), the last bin also holds 1.0. Values outside [-1, 1] are
 /// clamped into the end bins.
 std::vector<int64_t> scaled_jacobian_histogram(const std::vector<double>& values);
+
+/// "G-3/n=20", "selective" -> "G-3_n=20.selective.vtu": case names may hold '/'.
+std::string run_mesh_file_name(const std::string& case_name, const std::string& method);
 
 /// The source tree (HEXREFINE_SOURCE_DIR) and the shared folder beside it (its ../shared).
 std::string run_source_dir();

@@ -181,6 +181,15 @@ void case_execute(const RunCase& c, const std::vector<std::string>& methods, con
     fields["stats"] = refine_stats_to_json(s);
     check_measure(result.mesh, mesh, fields);
     quality_measure(result.mesh, fields);
+    if (!c.save_mesh_dir.empty()) {
+      const std::string name = run_mesh_file_name(c.name, method);
+      MeshWriteOptions write_options;
+      write_options.cell_scalars.emplace_back("scaled_jacobian",
+                                              mesh_scaled_jacobians(result.mesh));
+      mesh_write((std::filesystem::path(c.save_mesh_dir) / name).string(), result.mesh,
+                 write_options);
+      fields["mesh_file"] = (std::filesystem::path(c.save_mesh_dir).filename() / name).string();
+    }
     if (c.smooth) {
 #ifdef HEXREFINE_RUNNER_HAVE_SMOOTHING
       HexMesh smoothed = result.mesh;

@@ -202,6 +202,7 @@ HexMesh abaqus_read(const std::string& path) {
     }
   }
   if (!saw_keyword) in.fail("no Abaqus keyword line (*NODE, *ELEMENT) found");
+  if (items_sort_by_permutation_ids(mesh.points, node_ids)) node_lines.clear();
   IdIndex nodes;
   if (const int64_t bad = nodes.build(node_ids); bad >= 0)
     throw InputError(

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -131,7 +132,11 @@ MeshFormat mesh_format_of(const std::string& path) {
 }
 
 HexMesh mesh_read(const std::string& path) {
-  switch (mesh_format_of(path)) {
+  const MeshFormat format = mesh_format_of(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path + ": is a folder, expected a mesh file");
+  switch (format) {
     case MeshFormat::medit:
       return io_detail::medit_read(path);
     case MeshFormat::vtk_legacy:

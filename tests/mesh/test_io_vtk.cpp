@@ -156,6 +156,15 @@ TEST(IoFormat, ByExtension) {
   EXPECT_THROW(mesh_format_of("b.stl"), InputError);
   EXPECT_THROW(mesh_format_of("dir.vtk/b"), InputError);
   EXPECT_THROW(mesh_read("/nonexistent/x.vtk"), InputError);
+  const auto dir = test_temp_dir("io_format_folder");
+  std::filesystem::create_directories(dir / "folder.mesh");
+  try {
+    mesh_read((dir / "folder.mesh").string());
+    ADD_FAILURE() << "folder accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("folder.mesh: is a folder"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
+#include <random>
 
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
@@ -227,6 +229,49 @@ TEST(Conformity, DuplicateAndUnusedNodes) {
   EXPECT_EQ(r.duplicate_nodes, 2);
   EXPECT_EQ(r.unused_nodes, 3);
   EXPECT_TRUE(r.conformal);  // loose nodes do not break conformity
+}
+
+TEST(Conformity, DuplicateNodesMatchBruteForce) {
+  // Random points, a structured grid (points on any cell walls the search might use) and
+  // near-copies within and beyond the tolerance; compared with the O(n^2) definition.
+  HexMesh m = fixture_brick(12, 12, 12, 0.25);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(0.0, 3.0), unit(-1.0, 1.0);
+  for (int i = 0; i < 1500; ++i)
+    m.points.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+  const double tolerance = mesh_check_duplicate_tolerance * std::sqrt(27.0);
+  const int32_t originals = m.point_count();
+  for (int i = 0; i < 600; ++i) {
+    const Eigen::Vector3d& p = m.points[random() % originals];
+    const Eigen::Vector3d offset(unit(random), unit(random), unit(random));
+    const double scale = (i % 3 == 0) ? 0.0 : (i % 3 == 1 ? 0.5 : 2.0) * tolerance;
+    m.points.push_back(p + scale * offset.normalized());
+  }
+  int64_t expected = 0;
+  for (int32_t i = 0; i < m.point_count(); ++i)
+    for (int32_t j = 0; j < i; ++j)
+      if ((m.points[i] - m.points[j]).norm() <= tolerance) {
+        ++expected;
+        break;
+      }
+  ASSERT_GT(expected, 350);
+  ASSERT_LT(expected, 600);
+  EXPECT_EQ(mesh_check(m).duplicate_nodes, expected);
+}
+
+TEST(Conformity, DuplicateNodesStraddlingASearchCellWall) {
+  // White-box: mirrors the cell size and origin of the duplicate search (mesh/conformity.cpp) to
+  // put a near pair on both sides of a cell wall in x and y.
+  HexMesh m;
+  for (int i = 0; i < 8; ++i) m.points.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  const double cell = 1.6180339887 / std::cbrt(10.0);
+  const double wall = -0.3819660113 * cell + cell;
+  const double tolerance = mesh_check_duplicate_tolerance * std::sqrt(3.0);
+  m.points.emplace_back(wall - 0.3 * tolerance, wall - 0.3 * tolerance, 0.5);
+  m.points.emplace_back(wall + 0.3 * tolerance, wall + 0.3 * tolerance, 0.5);
+  EXPECT_EQ(mesh_check(m).duplicate_nodes, 1);
+  m.points.back() = Eigen::Vector3d(wall + 0.8 * tolerance, wall + 0.8 * tolerance, 0.5);
+  EXPECT_EQ(mesh_check(m).duplicate_nodes, 0);  // 1.6 sqrt(2) x tolerance apart
 }
 
 TEST(Conformity, CrackOfDuplicatedNodesLeavesCoincidentFaces) {

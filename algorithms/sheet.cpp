@@ -19,8 +19,13 @@
 //     one dual sheet; a union-find over the split edges gives the connected pieces of the dual
 //     sheets that must be refined (a sheet pass refines one such piece: all hexes around each
 //     split edge at once, which keeps the mesh conformal). A piece that occupies two directions
-//     of one hex is a sheet crossing itself where it must refine: refused (OperationError naming
-//     the sheet and the hexes). Pieces are coloured first-fit so that no two pieces of one
+//     of one hex is a sheet crossing itself where it must refine (Harris' special case): if all
+//     edges of the hex are split, the pass refines both directions at once with the composite
+//     1-9 template (1-3 across one direction then the other, as one template; 1-27 for three);
+//     otherwise a transition template for two directions would be needed, and the case is
+//     refused (OperationError naming the sheet and the hexes). The dual sheets that cross
+//     themselves in a refined hex are counted (self_intersection_cases, per hex).
+//     Pieces are coloured first-fit so that no two pieces of one
 //     colour share a hex; one colour is one round, and processing the pieces of one round
 //     together is the same as processing them one after the other, since they share no hex.
 //     For a structured brick the rounds are the x-, y- and z-like sheets.
@@ -84,7 +89,7 @@ bool edges_share_face(int a, int b) {
 struct Orientation {
   const HexTemplate* tmpl = nullptr;
   int8_t symmetry = 0;
-  int8_t axis = 0;  // the parent local axis this orientation refines
+  uint8_t axes = 0;  // bit k: refines parent local axis k (two or three bits for 1-9, 1-27)
   std::vector<std::array<int8_t, 3>> child_axis;
   std::vector<uint8_t> child_edge_nodes;
 };
@@ -94,9 +99,31 @@ struct DirectionalTable {
   std::array<int16_t, 4096> by_mask{};  // split mask (edges of one axis) -> orientation, or -1
 };
 
+// 1-9: the x- and y-parallel edges split, 3 x 3 columns: 1-3 across x then across y, as one
+// template. Used where a dual sheet crosses itself in a fully marked hex (Harris' special case:
+// the hex is refined in its two directions of that sheet within the sheet's pass).
+const HexTemplate& sheet_template_1_9() {
+  static const HexTemplate t = [] {
+    HexTemplate r;
+    r.tag = TemplateTag::sheet;
+    auto id = [](int i, int j, int k) { return static_cast<int16_t>(i + 4 * (j + 4 * k)); };
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) r.nodes.push_back({{i / 3.0, j / 3.0, double(k)}});
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i)
+        r.children.push_back({id(i, j, 0), id(i + 1, j, 0), id(i + 1, j + 1, 0), id(i, j + 1, 0),
+                              id(i, j, 1), id(i + 1, j, 1), id(i + 1, j + 1, 1), id(i, j + 1, 1)});
+    return r;
+  }();
+  return t;
+}
+
+// The directional templates (one direction) and the composites for self-intersecting sheets
+// (two directions: 1-9; three: 1-27). Their split masks never coincide.
 const std::vector<const HexTemplate*>& directional_templates() {
-  static const std::vector<const HexTemplate*> list = {&template_1_3(), &template_1_4(),
-                                                       &template_1_5()};
+  static const std::vector<const HexTemplate*> list = {
+      &template_1_3(), &template_1_4(), &template_1_5(), &sheet_template_1_9(), &template_1_27()};
   return list;
 }
 
@@ -110,7 +137,8 @@ Orientation orientation_make(const HexTemplate& t, int s) {
   o.tmpl = &t;
   o.symmetry = static_cast<int8_t>(s);
   const uint16_t mask = cube_symmetry_edge_mask(sym, template_split_edges(t));
-  o.axis = static_cast<int8_t>(hex_edge_axis[std::countr_zero(mask)]);
+  for (int e = 0; e < 12; ++e)
+    if (mask & (1u << e)) o.axes |= static_cast<uint8_t>(1u << hex_edge_axis[e]);
   for (const auto& child : t.children) {
     std::array<std::array<double, 3>, 8> p{};
     for (int j = 0; j < 8; ++j) {
@@ -140,6 +168,9 @@ Orientation orientation_make(const HexTemplate& t, int s) {
         if (std::abs(p[j][c]) < kSnap || std::abs(p[j][c] - 1.0) < kSnap) ++extreme;
       if (extreme == 2) edge_nodes |= static_cast<uint8_t>(1u << j);
     }
+    // A composite (1-9, 1-27) is the sequence of 1-3s in a fully marked hex: there, every
+    // node lies on a split edge of an intermediate hex and is marked.
+    if (std::popcount(o.axes) > 1) edge_nodes = 0xFF;
     o.child_axis.push_back(axes);
     o.child_edge_nodes.push_back(edge_nodes);
   }
@@ -426,6 +457,8 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
         s[k] = sheets.find(topology.hex_edge_ids[h][hex_axis_edges[k][0]]);
       if (s[0] == s[1] || s[1] == s[2] || s[0] == s[2]) ++stats.self_intersection_cases;
       const auto& o = region.occurrence[i];
+      // All edges split: the piece's directions are refined together by 1-9 (or 1-27).
+      if (hex_split_mask(mesh, marking.node_marked, h) == 0xFFF) continue;
       for (int a = 0; a < 3; ++a)
         for (int b = a + 1; b < 3; ++b)
           if (o[a] >= 0 && o[a] == o[b]) {
@@ -438,8 +471,9 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
       throw OperationError(
           "sheet refinement: the dual sheet of edge " + edge_name(piece_edge[refused_piece]) +
           " crosses itself in hexes " + hex_list(refused) +
-          ", which it must refine in two directions within one sheet pass; self-intersecting "
-          "sheets are not handled by the sheet refiner (the selective refiner handles them)");
+          ", which it must refine in two directions within one sheet pass with transition "
+          "templates; that case of a self-intersecting sheet is not handled by the sheet refiner "
+          "(only fully refined hexes are: 1-9)");
   }
 
   // Rounds: first-fit colouring of the pieces; two pieces conflict when they share a hex.
@@ -505,50 +539,54 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
     const HexTopology rt = topology_build(cur);
     std::vector<TemplateApplication> apps;
     std::vector<int16_t> orientation_of(count, -1);
-    std::vector<int8_t> axis_of(count, -1);
+    std::vector<uint8_t> axes_of(count, 0);  // axes refined in this round
     for (int32_t h = 0; h < count; ++h) {
       auto& occ = region.occurrence[h];
+      uint8_t axes = 0;
+      int32_t piece = -1;
       for (int k = 0; k < 3; ++k) {
         if (occ[k] < 0 || color[occ[k]] != round) continue;
-        if (axis_of[h] >= 0)
+        // Two pieces of one colour never share a hex; one piece twice is a self-intersection.
+        if (piece >= 0 && occ[k] != piece)
           throw OperationError("sheet refinement: a hex descending from input hex " +
                                std::to_string(region.origin[h]) +
                                " would be refined in two directions in one round (sheets of "
                                "edges " +
-                               edge_name(piece_edge[occ[axis_of[h]]]) + " and " +
+                               edge_name(piece_edge[piece]) + " and " +
                                edge_name(piece_edge[occ[k]]) + ")");
-        axis_of[h] = static_cast<int8_t>(k);
+        piece = occ[k];
+        axes |= static_cast<uint8_t>(1u << k);
       }
-      if (axis_of[h] < 0) continue;
-      const int k = axis_of[h];
-      const uint16_t split = hex_split_mask(cur, region.node_marked, h) & axis_mask(k);
-      const int32_t piece = occ[k];
-      occ[k] = -1;
-      if (!split) {
-        axis_of[h] = -1;
-        continue;
-      }
+      if (!axes) continue;
+      uint16_t wanted = 0;
+      for (int k = 0; k < 3; ++k)
+        if (axes & (1u << k)) {
+          wanted |= axis_mask(k);
+          occ[k] = -1;
+        }
+      const uint16_t split = hex_split_mask(cur, region.node_marked, h) & wanted;
+      if (!split) continue;
       const int16_t o = table.by_mask[split];
       if (o < 0)
         throw OperationError("sheet refinement: a hex descending from input hex " +
                              std::to_string(region.origin[h]) +
                              " has a split pattern with no directional template (" +
-                             std::to_string(std::popcount(split)) +
-                             " parallel edges split) in the sheet of edge " +
-                             edge_name(piece_edge[piece]));
+                             std::to_string(std::popcount(split)) + " edges split in " +
+                             std::to_string(std::popcount(axes)) +
+                             " directions) in the sheet of edge " + edge_name(piece_edge[piece]));
       orientation_of[h] = o;
+      axes_of[h] = table.orientations[o].axes;
       apps.push_back({h, table.orientations[o].tmpl, table.orientations[o].symmetry});
     }
     // Conformity by construction needs every hex around a split edge to split it in this round.
     for (const TemplateApplication& a : apps) {
-      const int k = axis_of[a.hex];
-      const uint16_t split = hex_split_mask(cur, region.node_marked, a.hex) & axis_mask(k);
-      for (int e : hex_axis_edges[k]) {
-        if (!(split & (1u << e))) continue;
+      const uint16_t split = hex_split_mask(cur, region.node_marked, a.hex);
+      for (int e = 0; e < 12; ++e) {
+        if (!(split & (1u << e)) || !(axes_of[a.hex] & (1u << hex_edge_axis[e]))) continue;
         const int32_t id = rt.hex_edge_ids[a.hex][e];
         for (int32_t g : edge_hexes(rt, id)) {
           const int le = hex_local_edge(rt, g, id);
-          if (axis_of[g] < 0 || hex_edge_axis[le] != axis_of[g])
+          if (!(axes_of[g] & (1u << hex_edge_axis[le])))
             throw OperationError("sheet refinement: hexes descending from input hexes " +
                                  std::to_string(region.origin[a.hex]) + " and " +
                                  std::to_string(region.origin[g]) +
@@ -581,6 +619,7 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
       }
       const Orientation& orient = table.orientations[o];
       for (int k = 0; k < 3; ++k) {
+        // The parent's refined axes were set to -1 above: children are done in them.
         const int p = orient.child_axis[child][k];
         occurrence[i][k] = p < 0 ? -1 : region.occurrence[parent][p];
       }

@@ -241,6 +241,28 @@ TEST(SheetRefine, LShapedCaseRefinesTheWholeBrick) {
   EXPECT_NEAR(mesh_check(r.mesh).min_scaled_jacobian, 1.0, 1e-12);  // Table G-1: 1.0
 }
 
+TEST(SheetRefine, PassesRefineTheDescendantsOfTheTargetsAgain) {
+  // Thesis Table H-2's set-up: 4x4x4 brick, left surface. One pass: 16 targets x 27, their 16
+  // face neighbours x 13 (1-4 then three 1-4s), 32 untouched = 672.
+  const HexMesh m = fixture_brick(4, 4, 4);
+  Targets left;
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j) left.hexes.push_back(fixture_brick_hex(4, 4, 0, j, k));
+  std::sort(left.hexes.begin(), left.hexes.end());
+  const RefineResult one = sheet_refine(m, left, {});
+  EXPECT_EQ(one.mesh.hex_count(), 16 * 27 + 16 * 13 + 32);
+  RefineOptions two_passes;
+  two_passes.passes = 2;
+  const RefineResult two = sheet_refine(m, left, two_passes);
+  // The second pass refines the 432 children of the targets again, with their new transitions:
+  // a regression value of this implementation (three passes give 332,448; thesis Table H-2
+  // reports 332,864 for Harris' implementation).
+  EXPECT_EQ(two.mesh.hex_count(), 13632);
+  const auto& level = *mesh_find_attribute(two.mesh, attribute_refinement_level);
+  EXPECT_EQ(*std::max_element(level.begin(), level.end()), 2);
+  expect_checker_valid(two.mesh, m);
+}
+
 TEST(SheetRefine, AttributesInheritedAndUntouchedHexesKept) {
   HexMesh m = fixture_brick(3, 1, 1);
   m.attributes.push_back({"block_id", {7, 8, 9}});

@@ -12,8 +12,9 @@
 //     a directional template: four split -> 1-3, two on one face -> 1-4, one -> 1-5. Three, or
 //     two diagonal, would need an adjustment template Harris did not have: the hex is a
 //     multiply-connected transition. It is decided per hex and direction from the node marks
-//     on the original mesh; each such hex is added to the targets (its nodes marked) until none
-//     is left (worklist over the hexes around newly marked nodes).
+//     on the original mesh; all such hexes are added to the targets (their nodes marked) in
+//     waves until none is left (each wave looks only at the hexes around newly marked nodes).
+//     A hex all of whose nodes get marked is fully refined without being counted as added.
 //  3. Sheets. Only hexes with a split edge change. On the original mesh the dual is walked from
 //     those hexes: the split edges of one direction of one hex are parallel, so they belong to
 //     one dual sheet; a union-find over the split edges gives the connected pieces of the dual
@@ -25,10 +26,10 @@
 //     otherwise a transition template for two directions would be needed, and the case is
 //     refused (OperationError naming the sheet and the hexes). The dual sheets that cross
 //     themselves in a refined hex are counted (self_intersection_cases, per hex).
-//     Pieces are coloured first-fit so that no two pieces of one
-//     colour share a hex; one colour is one round, and processing the pieces of one round
-//     together is the same as processing them one after the other, since they share no hex.
-//     For a structured brick the rounds are the x-, y- and z-like sheets.
+//     Pieces are coloured first-fit so that no two pieces of one colour share a hex; one colour
+//     is one round, and processing the pieces of one round together is the same as processing
+//     them one after the other, since they share no hex (sheet_passes counts the pieces). For a
+//     structured brick the rounds are the x-, y- and z-like sheets.
 //  4. Rounds. The refined region (the hexes with a split edge) is copied with compact node ids
 //     and refined round by round with the directional templates (templates_apply). Every output
 //     hex carries, per local axis, the sheet piece it still has to be refined in; a child's axis
@@ -37,7 +38,12 @@
 //     inside a split edge are marked (so the strips of a 1-3 face are split in the next
 //     direction); new face and interior nodes are not. A fully refined hex goes
 //     1 -> 3 -> 9 -> 27 (13 deleted, 39 created, thesis 4.3).
-//  5. Assembly: the untouched hexes and the refined region in input hex order.
+//  5. Assembly: the untouched hexes and the refined region in input hex order. Every refined
+//     hex is tagged TemplateTag::sheet, its refinement level one above its input hex's.
+// Options: `passes` repeats the whole on the descendants of the given targets; the selective
+// refiner's options (ranking, propagation, ebe_only, buffer) do not apply and are ignored.
+// A safety check before every round makes sure all hexes around each split edge split it in
+// that round (OperationError otherwise), so a result is conformal by construction.
 //
 // Speed: every step is linear in the size of the refined region (plus one copy of the mesh and
 // one pass over its edges for the dual sheet labels); there is no rescan of the mesh per sheet.

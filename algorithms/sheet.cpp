@@ -370,7 +370,7 @@ std::string hex_list(const std::vector<int32_t>& hexes) {
 
 // One refinement of `targets` of `mesh`; statistics are accumulated into `stats`.
 PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
-                       const SheetRoundObserver* observer, RefineStats& stats) {
+                       const SheetControl& control, RefineStats& stats) {
   const auto t_start = Clock::now();
   const HexTopology topology = topology_build(mesh);
   SheetMarking marking;
@@ -513,6 +513,11 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
     }
   }
 
+  if (control.one_sheet_per_round) {
+    std::iota(color.begin(), color.end(), 0);
+    round_count = piece_count;
+  }
+
   // The region with compact node ids.
   {
     std::vector<int32_t> local_of(mesh.points.size(), -1);
@@ -638,7 +643,7 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
     region.occurrence = std::move(occurrence);
     region.origin = std::move(origin);
     region.node_marked = std::move(marked);
-    if (observer && *observer) (*observer)(region_assemble(mesh, affected, region).mesh, round);
+    if (control.observer) control.observer(region_assemble(mesh, affected, region).mesh, round);
   }
 
   if (!options.allow_inverted)
@@ -701,6 +706,13 @@ RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets,
 
 RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
                           const SheetRoundObserver& observer) {
+  SheetControl control;
+  control.observer = observer;
+  return sheet_refine(mesh, targets, options, control);
+}
+
+RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
+                          const SheetControl& control) {
   targets_validate(mesh, targets);
   if (options.passes < 1)
     throw InputError("sheet refinement: passes must be at least 1 (got " +
@@ -715,7 +727,7 @@ RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const Ref
   PassOutput current{mesh, {}};
   Targets pass_targets = targets;
   for (int pass = 0; pass < options.passes; ++pass) {
-    PassOutput next = refine_once(current.mesh, pass_targets, options, &observer, stats);
+    PassOutput next = refine_once(current.mesh, pass_targets, options, control, stats);
     if (pass + 1 < options.passes) {
       // The next pass refines the descendants of this pass's (given) targets.
       std::vector<uint8_t> was_target(current.mesh.hexes.size(), 0);

@@ -68,4 +68,16 @@ RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets,
 RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
                           const SheetRoundObserver& observer);
 
+/// How the sheet passes are scheduled and watched (tests, figures, studies).
+struct SheetControl {
+  SheetRoundObserver observer;  ///< called after every round, if set
+  /// Harris' order: one sheet piece per round, in piece order, instead of all the pieces that
+  /// share no hex together. Same result; one copy of the refined region per sheet (slower).
+  bool one_sheet_per_round = false;
+};
+
+/// As above, with a schedule and an observer.
+RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
+                          const SheetControl& control);
+
 }  // namespace hexrefine

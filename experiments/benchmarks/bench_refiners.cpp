@@ -2,7 +2,8 @@
 /// bricks (thesis Table G-2; n = 10, 25, 50), hexes within a fixed radius of the top front right
 /// vertex of a brick of fixed size (Table G-3; radius 0.5 of a unit brick, n = 10, 25, 50), the
 /// L-shaped case (Table G-1), the gear's teeth (Table H-1) and the left surface of a 4^3 brick
-/// refined three times (Table H-2). Wall-clock times
+/// refined three times (Table H-2). `sheet_one_per_pass` runs the sheet refiner in Harris' order
+/// (one sheet per pass) on the smaller bricks. Wall-clock times
 /// (UseRealTime). Counters: final hexes, hexes created and deleted, sheet passes, added targets,
 /// per-phase seconds (of the last iteration), and `s/initial_hex` (seconds per input hex; flat
 /// when the time grows linearly). A refiner that throws (e.g. not implemented yet) is reported
@@ -130,12 +131,27 @@ void bench_left_three_passes(benchmark::State& state, RefineFunction refine) {
   run(state, refine, mesh, left, options);
 }
 
+// Harris' order, one sheet per pass with a copy and topology build of the refined region per
+// pass: what a per-sheet implementation costs (the grouped rounds above do the same passes).
+RefineResult sheet_one_per_pass(const HexMesh& mesh, const Targets& targets,
+                                const RefineOptions& options) {
+  SheetControl control;
+  control.one_sheet_per_round = true;
+  return sheet_refine(mesh, targets, options, control);
+}
+
 void sizes(benchmark::internal::Benchmark* b) {
   b->Arg(10)->Arg(25)->Arg(50)->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 
 BENCHMARK_CAPTURE(bench_full_brick, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, selective, selective)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_full_brick, sheet_one_per_pass, &sheet_one_per_pass)
+    ->Arg(10)
+    ->Arg(20)
+    ->Arg(25)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(bench_radial, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_radial, selective, selective)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_l_shaped, sheet, sheet)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -18,7 +18,7 @@ const char* usage_text =
     "usage: hexrefine COMMAND ...\n"
     "  generate brick OUT --dims NX,NY,NZ [--size LX,LY,LZ] [--jitter F --seed S]\n"
     "  generate gear|cylinder|twisted-ring|stepped OUT [options]\n"
-    "  check MESH [--report R.json]\n"
+    "  check MESH [--reference REF] [--report R.json]\n"
     "  convert IN OUT [--binary]\n"
     "  sheets MESH [--report R.json]\n"
     "  refine IN OUT --method selective|sheet --select SPEC [--select SPEC ...] [--passes N]\n"

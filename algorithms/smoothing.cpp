@@ -9,29 +9,35 @@
 /// - P. M. Knupp, "Algebraic mesh quality metrics", SIAM J. Sci. Comput. 23 (2001) 193-218: the
 ///   mean ratio of a corner matrix A against the identity, |A|_F^2 / (3 det(A)^(2/3)) in its
 ///   inverse form (1 for a scaled rotation, growing without bound as det(A) -> 0+).
-/// - L. Freitag, M. Jones, P. Plassmann, "An efficient parallel algorithm for mesh smoothing"
-///   (IMR 1995) and the "smart" Laplacian idea: a Laplacian move is kept only if it does not make
-///   the local quality worse; local optimisation that maximises the minimum quality around a node.
+/// - L. A. Freitag, "On combining Laplacian and optimization-based mesh smoothing techniques",
+///   AMD Trends in Unstructured Mesh Generation 220 (1997) 37-43: "smart" Laplacian (a move is
+///   kept only if the local quality does not get worse) and optimisation of the minimum quality
+///   around a node only where the cheap Laplacian move does not suffice.
 ///
 /// Steps of mesh_smooth:
-///  1. Classify nodes from the boundary faces around them (interior, planar, curved, feature);
-///     movable nodes are the interior and planar nodes of the region hexes.
-///  2. Per sweep, order the movable nodes worst-first (lowest scaled Jacobian of their hexes) by a
-///     counting sort on the quantised quality (ties by node id: deterministic, linear time).
-///  3. Visit each node (Gauss-Seidel: moves are seen at once by later nodes):
-///     - laplacian: the mean of the edge neighbours (projected onto the plane for planar nodes);
-///       full, half or quarter move kept if the guard holds.
-///     - optimize: (a) a few damped Newton steps on the sum of inverse mean ratios of the corner
-///       matrices that depend on the node (analytic gradient, Hessian by differences of the
-///       gradient, eigenvalues clamped positive), kept if the guard holds; then (b) ascent of a
+///  1. Classify nodes from the boundary faces around them (mesh_classify_smooth_nodes: interior,
+///     planar, curved, feature); the movable nodes are the interior and planar nodes of the region
+///     hexes. All of them are active for the first sweep.
+///  2. Per sweep, order the active movable nodes worst-first (lowest scaled Jacobian of their
+///     hexes) by a counting sort on the quantised quality (ties by node id: deterministic, linear).
+///  3. Visit each node (Gauss-Seidel: moves are seen at once by later nodes). Every candidate
+///     position (projected onto the plane for planar nodes) goes through one rule, the guard:
+///     no hex with a positive scaled Jacobian becomes non-positive, every hex around the node stays
+///     >= the node's current local minimum, and the local minimum or the sum of the scaled
+///     Jacobians around the node rises. Hexes elsewhere are unchanged, hence the mesh minimum never
+///     decreases, and a mesh that cannot be improved (e.g. perfect boxes) is left as it is.
+///     - laplacian: the mean of the edge neighbours, tried as a full, half and quarter move.
+///     - optimize: (a) the Laplacian candidate (cheap, and it untangles where (b) cannot start);
+///       (b) one damped Newton step on the sum of inverse mean ratios of the corner matrices that
+///       depend on the node (analytic gradient, Hessian by differences of the gradient, eigenvalues
+///       clamped positive, backtracking while the sum does not fall); (c) three ascent steps on a
 ///       soft minimum of the scaled-Jacobian samples of the hexes around the node
 ///       (central-difference gradient, backtracking until the true local minimum rises), which
 ///       targets exactly the quantity the thesis reports.
-///     The guard: every hex around the node keeps a scaled Jacobian >= the node's current local
-///     minimum, and no hex with a positive value becomes non-positive. Hexes elsewhere are
-///     unchanged, hence the mesh minimum never decreases.
-///  4. Stop after max_sweeps or when a sweep moves no node by more than 1e-7 of its local edge
-///     length, or improves neither the minimum (by 1e-9) nor the mean (by 1e-6).
+///     Nodes of the hexes around a node that moved become active for the next sweep.
+///  4. Stop after max_sweeps, when no node is active, or when a sweep moves no node by more than
+///     1e-7 of its local edge length or improves neither the minimum (by 1e-9) nor the mean (by
+///     1e-6).
 
 #include "algorithms/smoothing.hpp"
 

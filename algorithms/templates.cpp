@@ -82,65 +82,6 @@ std::array<CubeSymmetry, 48> make_symmetries() {
   return out;
 }
 
-// Node slots: an edge holds up to 4 keyed nodes (split positions in sixths, and adjustment
-// nodes), a face up to 4 (the 1-9 face template's interior nodes).
-constexpr int kEdgeSlots = 4;
-constexpr int kFaceSlots = 4;
-constexpr int kAdjustmentCode = 10;  // edge slot code of adjustment node k: kAdjustmentCode + k
-
-struct Slot {
-  int32_t code = -1;
-  int32_t node = -1;
-};
-
-class NodeTable {
- public:
-  NodeTable(int32_t edges, int32_t faces) : edge_block_(edges, -1), face_block_(faces, -1) {}
-
-  // Returns the slot for `code` in the block of entity `id`, creating block and slot as needed;
-  // nullptr if the block is full.
-  Slot* edge_slot(int32_t id, int32_t code) {
-    return find(edge_block_, edge_slots_, kEdgeSlots, id, code);
-  }
-  Slot* face_slot(int32_t id, int32_t code) {
-    return find(face_block_, face_slots_, kFaceSlots, id, code);
-  }
-
- private:
-  static Slot* find(std::vector<int32_t>& block, std::vector<Slot>& slots, int capacity, int32_t id,
-                    int32_t code) {
-    if (block[id] < 0) {
-      block[id] = static_cast<int32_t>(slots.size());
-      slots.resize(slots.size() + capacity);
-    }
-    Slot* b = slots.data() + block[id];
-    for (int i = 0; i < capacity; ++i) {
-      if (b[i].code == code) return &b[i];
-      if (b[i].code < 0) {
-        b[i].code = code;
-        return &b[i];
-      }
-    }
-    return nullptr;
-  }
-  std::vector<int32_t> edge_block_, face_block_;
-  std::vector<Slot> edge_slots_, face_slots_;
-};
-
-// Canonical (u6, v6) code of a point with bilinear weights w[i] on the face corners whose global
-// ids are g[i] (in the hex's local face order).
-int32_t face_code(const std::array<int32_t, 4>& g, const std::array<double, 4>& w) {
-  int i0 = 0;
-  for (int i = 1; i < 4; ++i)
-    if (g[i] < g[i0]) i0 = i;
-  const int step = g[(i0 + 1) % 4] < g[(i0 + 3) % 4] ? 1 : 3;
-  std::array<double, 4> c{};
-  for (int k = 0; k < 4; ++k) c[k] = w[(i0 + k * step) % 4];
-  const int u6 = static_cast<int>(std::lround(6.0 * (c[1] + c[2])));
-  const int v6 = static_cast<int>(std::lround(6.0 * (c[2] + c[3])));
-  return u6 * 7 + v6;
-}
-
 Eigen::Vector3d trilinear(const std::array<Eigen::Vector3d, 8>& x, const std::array<double, 3>& p) {
   Eigen::Vector3d out = Eigen::Vector3d::Zero();
   for (int v = 0; v < 8; ++v) {
@@ -246,6 +187,233 @@ uint16_t template_split_edges(const HexTemplate& tmpl) {
   return mask;
 }
 
+namespace {
+
+constexpr int64_t kUnit = template_param_unit;
+
+TemplateNodeKey make_key(TemplateNodeKey::Kind kind, int64_t id, int64_t a = 0, int64_t b = 0) {
+  return {(static_cast<int64_t>(kind) << 40) | id, a, b};
+}
+
+std::array<double, 3> param_to_ref(const TemplateParam& p) {
+  return {double(p[0]) / kUnit, double(p[1]) / kUnit, double(p[2]) / kUnit};
+}
+
+// Exact image of a template position given in sixths under the cell's trilinear frame; false if
+// it is not representable (nested too deep).
+bool cell_map_sixths(const TemplateCell& cell, const std::array<int64_t, 3>& p6,
+                     TemplateParam& out) {
+  std::array<int64_t, 3> sum = {0, 0, 0};
+  for (int v = 0; v < 8; ++v) {
+    int64_t w = 1;
+    for (int k = 0; k < 3; ++k) w *= hex_corner[v][k] ? p6[k] : 6 - p6[k];
+    if (w == 0) continue;
+    for (int k = 0; k < 3; ++k) sum[k] += w * cell.param[v][k];
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (sum[k] % 216 != 0) return false;
+    out[k] = sum[k] / 216;
+  }
+  return true;
+}
+
+}  // namespace
+
+TemplateRefiner::TemplateRefiner(const HexMesh& mesh, const HexTopology& topology)
+    : mesh_(mesh), topology_(topology), points_(mesh.points) {
+  nodes_.reserve(mesh.points.size());
+}
+
+TemplateCell TemplateRefiner::cell_whole(int32_t hex) const {
+  TemplateCell c;
+  c.hex = hex;
+  c.nodes = mesh_.hexes[hex];
+  for (int v = 0; v < 8; ++v) {
+    for (int k = 0; k < 3; ++k) c.param[v][k] = hex_corner[v][k] * kUnit;
+    c.key[v] = make_key(TemplateNodeKey::corner, c.nodes[v]);
+  }
+  return c;
+}
+
+TemplateNodeKey TemplateRefiner::key_adjustment(int32_t edge, int k) {
+  return make_key(TemplateNodeKey::adjustment, edge, k);
+}
+
+TemplateNodeKey TemplateRefiner::key_at(int32_t hex, const TemplateParam& p) const {
+  const HexCell& cell = mesh_.hexes[hex];
+  int extreme = 0, free_axis = -1, fixed_axis = -1;
+  for (int k = 0; k < 3; ++k) {
+    if (p[k] == 0 || p[k] == kUnit) {
+      ++extreme;
+      fixed_axis = k;
+    } else {
+      free_axis = k;
+    }
+  }
+  if (extreme == 3)
+    return make_key(TemplateNodeKey::corner,
+                    cell[vertex_of({int(p[0] / kUnit), int(p[1] / kUnit), int(p[2] / kUnit)})]);
+  if (extreme == 2) {
+    std::array<double, 3> r = param_to_ref(p);
+    const int le = local_edge_at(r, free_axis);
+    const int32_t e = topology_.hex_edge_ids[hex][le];
+    int64_t t = p[free_axis];
+    if (cell[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t = kUnit - t;
+    return make_key(TemplateNodeKey::edge, e, t);
+  }
+  if (extreme == 1) {
+    const int lf = 2 * fixed_axis + (p[fixed_axis] == kUnit ? 1 : 0);
+    const int32_t f = topology_.hex_face_ids[hex][lf];
+    std::array<int32_t, 4> g{};
+    for (int c = 0; c < 4; ++c) g[c] = cell[hex_faces[lf][c]];
+    int i0 = 0;
+    for (int i = 1; i < 4; ++i)
+      if (g[i] < g[i0]) i0 = i;
+    const int step = g[(i0 + 1) % 4] < g[(i0 + 3) % 4] ? 1 : 3;
+    const int* o = hex_corner[hex_faces[lf][i0]];
+    const int* c1 = hex_corner[hex_faces[lf][(i0 + step) % 4]];
+    const int* c3 = hex_corner[hex_faces[lf][(i0 + 3 * step) % 4]];
+    int64_t u = 0, v = 0;
+    for (int k = 0; k < 3; ++k) {
+      u += (c1[k] - o[k]) * (p[k] - o[k] * kUnit);
+      v += (c3[k] - o[k]) * (p[k] - o[k] * kUnit);
+    }
+    return make_key(TemplateNodeKey::face, f, u, v);
+  }
+  return make_key(TemplateNodeKey::interior, hex, p[0] * (kUnit + 1) + p[1], p[2]);
+}
+
+bool TemplateRefiner::alias(const TemplateNodeKey& from, const TemplateNodeKey& to) {
+  auto [it, inserted] = aliases_.emplace(from, to);
+  return inserted || it->second == to;
+}
+
+int32_t TemplateRefiner::node_of(const TemplateNodeKey& key, const Eigen::Vector3d& x,
+                                 bool* aliased) {
+  TemplateNodeKey k = key;
+  if (!aliases_.empty()) {
+    const auto it = aliases_.find(key);
+    if (it != aliases_.end()) {
+      k = it->second;
+      if (aliased) *aliased = true;
+    }
+  }
+  if (k.kind() == TemplateNodeKey::corner) return static_cast<int32_t>(k.entity & 0xFFFFFFFFFF);
+  const auto [it, inserted] = nodes_.emplace(k, static_cast<int32_t>(points_.size()));
+  if (inserted) points_.push_back(x);
+  return it->second;
+}
+
+void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int symmetry,
+                            std::vector<TemplateCell>& children) {
+  const CubeSymmetry& s = cube_symmetries()[symmetry];
+  const int32_t h = cell.hex;
+  const HexCell& input = mesh_.hexes[h];
+  const std::array<Eigen::Vector3d, 8> x = hex_points(mesh_, h);
+  std::array<Eigen::Vector3d, 8> xc;
+  for (int v = 0; v < 8; ++v) xc[v] = points_[cell.nodes[v]];
+  auto fail = [&](const std::string& why) {
+    throw OperationError("hex " + std::to_string(h) + " (" + template_tag_name(t.tag) +
+                         "): " + why);
+  };
+  if (!cell.exact && !cell.whole) fail("a sub-hex with inexact corners cannot be refined again");
+
+  struct Placed {
+    int32_t node;
+    TemplateParam param;
+    TemplateNodeKey key;
+    bool exact, aliased;
+  };
+  std::vector<Placed> placed(t.nodes.size());
+  for (size_t i = 0; i < t.nodes.size(); ++i) {
+    const TemplateNode& tn = t.nodes[i];
+    const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
+    Placed& out = placed[i];
+    out.aliased = false;
+    std::array<int64_t, 3> p6{};
+    bool on_grid = true;
+    for (int k = 0; k < 3; ++k) {
+      p6[k] = std::lround(6.0 * p[k]);
+      on_grid = on_grid && std::abs(6.0 * p[k] - double(p6[k])) < 1e-9;
+    }
+    out.exact = on_grid && cell.exact && cell_map_sixths(cell, p6, out.param);
+    int corner = -1;
+    if (on_grid && (p6[0] % 6 == 0) && (p6[1] % 6 == 0) && (p6[2] % 6 == 0))
+      corner = vertex_of({int(p6[0] / 6), int(p6[1] / 6), int(p6[2] / 6)});
+    if (corner >= 0 && tn.adjustment_edge < 0) {
+      out.node = cell.nodes[corner];
+      out.param = cell.param[corner];
+      out.key = cell.key[corner];
+      out.exact = cell.exact;
+      continue;
+    }
+    const Eigen::Vector3d position =
+        out.exact ? trilinear(x, param_to_ref(out.param)) : trilinear(xc, p);
+    if (tn.adjustment_edge >= 0) {
+      if (cell.whole) {
+        const int le = s.edge[tn.adjustment_edge];
+        const int32_t e = topology_.hex_edge_ids[h][le];
+        // Adjustment index in the edge's global direction.
+        const bool same_direction = input[hex_edges[le][0]] == topology_.edge_nodes[e][0];
+        const bool canonical_same = s.vertex[hex_edges[tn.adjustment_edge][0]] == hex_edges[le][0];
+        const int k =
+            (same_direction == canonical_same) ? tn.adjustment_index : 1 - tn.adjustment_index;
+        out.key = key_adjustment(e, k);
+      } else {
+        if (!out.exact) fail("adjustment node off the exact grid");
+        out.key = key_at(h, out.param);
+      }
+      out.node = node_of(out.key, position, nullptr);
+      points_[out.node] = position;  // the owner places its adjustment nodes
+      continue;
+    }
+    if (!out.exact) {
+      // Off the grid: only an interior node of a cell that is not refined again.
+      bool interior = true;
+      for (int k = 0; k < 3; ++k) interior = interior && p[k] > 1e-12 && p[k] < 1 - 1e-12;
+      if (!interior) fail("a node on the cell's boundary is off the exact grid");
+      points_.push_back(position);
+      out.node = static_cast<int32_t>(points_.size() - 1);
+      out.key = make_key(TemplateNodeKey::fresh, out.node);
+      continue;
+    }
+    out.key = key_at(h, out.param);
+    out.node = node_of(out.key, position, &out.aliased);
+  }
+
+  for (const auto& child : t.children) {
+    std::array<int16_t, 8> c = child;
+    if (s.reflection) c = {c[0], c[3], c[2], c[1], c[4], c[7], c[6], c[5]};
+    TemplateCell out;
+    out.hex = h;
+    out.whole = false;
+    out.exact = true;
+    for (int k = 0; k < 8; ++k) {
+      const Placed& pl = placed[c[k]];
+      out.nodes[k] = pl.node;
+      out.param[k] = pl.param;
+      out.key[k] = pl.key;
+      out.exact = out.exact && pl.exact;
+      out.collapsed = out.collapsed || pl.aliased;
+    }
+    // Local axes of the child in the cell's frame (sum of its four parallel edges), then in the
+    // input hex's frame.
+    for (int k = 0; k < 3; ++k) {
+      std::array<double, 3> d = {0, 0, 0};
+      for (int e : hex_axis_edges[k]) {
+        const auto pa = cube_symmetry_apply(s, t.nodes[c[hex_edges[e][0]]].ref);
+        const auto pb = cube_symmetry_apply(s, t.nodes[c[hex_edges[e][1]]].ref);
+        for (int m = 0; m < 3; ++m) d[m] += pb[m] - pa[m];
+      }
+      int best = 0;
+      for (int m = 1; m < 3; ++m)
+        if (std::abs(d[m]) > std::abs(d[best])) best = m;
+      out.axis[k] = cell.axis[best];
+    }
+    children.push_back(out);
+  }
+}
+
 TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topology,
                                     std::span<const TemplateApplication> applications,
                                     std::span<const TemplateFaceAlias> aliases) {
@@ -258,29 +426,18 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
                            " is out of range or has two templates");
     application_of[h] = static_cast<int32_t>(i);
   }
-
-  // Face aliases: face-template nodes redirected to an edge's adjustment nodes.
-  std::vector<int32_t> alias_of_face;
-  if (!aliases.empty()) {
-    alias_of_face.assign(topology.face_count(), -1);
-    for (size_t i = 0; i < aliases.size(); ++i)
-      alias_of_face[aliases[i].face] = static_cast<int32_t>(i);
-  }
+  TemplateRefiner refiner(mesh, topology);
+  for (const TemplateFaceAlias& al : aliases)
+    for (int k = 0; k < 2; ++k)
+      refiner.alias(make_key(TemplateNodeKey::face, al.face, al.face_positions[k][0] * kUnit / 6,
+                             al.face_positions[k][1] * kUnit / 6),
+                    TemplateRefiner::key_adjustment(al.edge, k));
 
   TemplateApplyResult out;
   HexMesh& res = out.mesh;
-  res.points = mesh.points;
   res.hexes.reserve(mesh.hexes.size());
   out.parent.reserve(mesh.hexes.size());
-  NodeTable table(topology.edge_count(), topology.face_count());
-  const auto& symmetries = cube_symmetries();
-
-  auto new_point = [&](const Eigen::Vector3d& x) {
-    res.points.push_back(x);
-    return static_cast<int32_t>(res.points.size() - 1);
-  };
-
-  std::vector<int32_t> node_ids;
+  std::vector<TemplateCell> children;
   for (int32_t h = 0; h < nh; ++h) {
     const int32_t a = application_of[h];
     if (a < 0) {
@@ -288,93 +445,21 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
       out.parent.push_back(h);
       continue;
     }
-    const TemplateApplication& app = applications[a];
-    const HexTemplate& t = *app.tmpl;
-    const CubeSymmetry& s = symmetries[app.symmetry];
-    const HexCell& cell = mesh.hexes[h];
-    const std::array<Eigen::Vector3d, 8> x = hex_points(mesh, h);
-    auto fail = [&](const std::string& why) {
-      throw OperationError("templates_apply: hex " + std::to_string(h) + " (" +
-                           template_tag_name(t.tag) + "): " + why);
-    };
-    node_ids.assign(t.nodes.size(), -1);
-    for (size_t i = 0; i < t.nodes.size(); ++i) {
-      const TemplateNode& tn = t.nodes[i];
-      const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
-      if (tn.adjustment_edge >= 0) {
-        const int le = s.edge[tn.adjustment_edge];
-        const int32_t e = topology.hex_edge_ids[h][le];
-        // Adjustment index in the edge's global direction.
-        const bool same_direction = cell[hex_edges[le][0]] == topology.edge_nodes[e][0];
-        const bool canonical_same = s.vertex[hex_edges[tn.adjustment_edge][0]] == hex_edges[le][0];
-        const int k =
-            (same_direction == canonical_same) ? tn.adjustment_index : 1 - tn.adjustment_index;
-        Slot* slot = table.edge_slot(e, kAdjustmentCode + k);
-        if (!slot) fail("too many nodes on edge " + std::to_string(e));
-        if (slot->node < 0) slot->node = new_point(trilinear(x, p));
-        node_ids[i] = slot->node;
-        continue;
-      }
-      int extreme = 0, free_axis = -1, fixed_axis = -1;
-      for (int k = 0; k < 3; ++k) {
-        if (is_extreme(p[k])) {
-          ++extreme;
-          fixed_axis = k;
-        } else {
-          free_axis = k;
-        }
-      }
-      if (extreme == 3) {
-        node_ids[i] = cell[vertex_of(
-            {int(std::lround(p[0])), int(std::lround(p[1])), int(std::lround(p[2]))})];
-      } else if (extreme == 2) {
-        const int le = local_edge_at(p, free_axis);
-        const int32_t e = topology.hex_edge_ids[h][le];
-        int k6 = static_cast<int>(std::lround(6.0 * p[free_axis]));
-        if (cell[hex_edges[le][0]] != topology.edge_nodes[e][0]) k6 = 6 - k6;
-        Slot* slot = table.edge_slot(e, k6);
-        if (!slot) fail("too many nodes on edge " + std::to_string(e));
-        if (slot->node < 0) slot->node = new_point(trilinear(x, p));
-        node_ids[i] = slot->node;
-      } else if (extreme == 1) {
-        const int lf = 2 * fixed_axis + static_cast<int>(std::lround(p[fixed_axis]));
-        const int32_t f = topology.hex_face_ids[h][lf];
-        std::array<int32_t, 4> g{};
-        std::array<double, 4> w{};
-        for (int c = 0; c < 4; ++c) {
-          const int v = hex_faces[lf][c];
-          g[c] = cell[v];
-          double wc = 1.0;
-          for (int k = 0; k < 3; ++k)
-            if (k != fixed_axis) wc *= hex_corner[v][k] ? p[k] : 1.0 - p[k];
-          w[c] = wc;
-        }
-        const int32_t code = face_code(g, w);
-        Slot* slot = nullptr;
-        if (!alias_of_face.empty() && alias_of_face[f] >= 0) {
-          const TemplateFaceAlias& al = aliases[alias_of_face[f]];
-          for (int k = 0; k < 2; ++k)
-            if (al.face_positions[k][0] * 7 + al.face_positions[k][1] == code)
-              slot = table.edge_slot(al.edge, kAdjustmentCode + k);
-        }
-        if (!slot) slot = table.face_slot(f, code);
-        if (!slot) fail("too many nodes on face " + std::to_string(f));
-        if (slot->node < 0) slot->node = new_point(trilinear(x, p));
-        node_ids[i] = slot->node;
-      } else {
-        node_ids[i] = new_point(trilinear(x, p));
-      }
+    children.clear();
+    try {
+      refiner.apply(refiner.cell_whole(h), *applications[a].tmpl, applications[a].symmetry,
+                    children);
+    } catch (const OperationError& e) {
+      throw OperationError(std::string("templates_apply: ") + e.what());
     }
-    for (const auto& child : t.children) {
-      HexCell c{};
-      for (int k = 0; k < 8; ++k) c[k] = node_ids[child[k]];
-      if (s.reflection) c = {c[0], c[3], c[2], c[1], c[4], c[7], c[6], c[5]};
-      res.hexes.push_back(c);
+    for (const TemplateCell& c : children) {
+      res.hexes.push_back(c.nodes);
       out.parent.push_back(h);
     }
-    out.hexes_created += static_cast<int64_t>(t.children.size());
+    out.hexes_created += static_cast<int64_t>(children.size());
     out.hexes_deleted += 1;
   }
+  res.points = std::move(refiner.points());
 
   // Attributes: inherited from the parent; template tag and refinement level updated.
   for (const HexAttribute& attr : mesh.attributes) {
@@ -578,6 +663,117 @@ const HexTemplate& template_1_5() {
     return b.take();
   }();
   return t;
+}
+
+const HexTemplate& template_1_13() {
+  // The four edges of face z=0 split: 1-9 on the bottom, 1-4 face templates on the four sides
+  // (transition nodes at z = 1/2), top face whole. Nine bottom-layer hexes over the 3x3 bottom
+  // grid (the corner ones reach the top corners, since each side's quad (A, P1, Q1, D) holds the
+  // whole vertical edge) whose tops meet at four interior nodes (i/3, j/3, t); the upper region,
+  // bounded by 14 quads, is filled by four hexes: two side hexes over the y=0 and y=1 edge-hexes
+  // (each also taking the tops of the two adjacent corner hexes), a centre hex whose top joins
+  // the x-side transition nodes, and a top hex holding the face z=1. 13 children.
+  static const HexTemplate t = template_1_13_build(template_1_13_interior_height);
+  return t;
+}
+
+HexTemplate template_1_13_build(double interior_height) {
+  {
+    TemplateBuilder b(TemplateTag::t1_13);
+    const double h = 0.5, tz = interior_height;
+    // Top node of bottom-layer grid line (i, j), i, j in 0..3.
+    auto top = [&](int i, int j) {
+      const bool ei = i == 0 || i == 3, ej = j == 0 || j == 3;
+      const double z = (ei && ej) ? 1.0 : (ei || ej) ? h : tz;
+      return b.node(i / 3.0, j / 3.0, z);
+    };
+    auto bottom = [&](int i, int j) { return b.node(i / 3.0, j / 3.0, 0); };
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i)
+        b.child({bottom(i, j), bottom(i + 1, j), bottom(i + 1, j + 1), bottom(i, j + 1), top(i, j),
+                 top(i + 1, j), top(i + 1, j + 1), top(i, j + 1)});
+    const int16_t c00 = b.node(0, 0, 1), c10 = b.node(1, 0, 1), c11 = b.node(1, 1, 1),
+                  c01 = b.node(0, 1, 1);
+    b.child({top(1, 0), top(2, 0), top(2, 1), top(1, 1), c00, c10, top(3, 1), top(0, 1)});
+    b.child({top(1, 3), top(2, 3), top(2, 2), top(1, 2), c01, c11, top(3, 2), top(0, 2)});
+    b.child(
+        {top(1, 1), top(2, 1), top(2, 2), top(1, 2), top(0, 1), top(3, 1), top(3, 2), top(0, 2)});
+    b.child({top(0, 1), top(3, 1), top(3, 2), top(0, 2), c00, c10, c11, c01});
+    return b.take();
+  }
+}
+
+namespace {
+
+// The three slabs across x of the adjusted 1-3 templates: the end slabs hold the whole faces
+// x=0 and x=1, inner sections are the quad `section` (y, z) whose corners at adjusted edges are
+// adjustment nodes (index 0 at x=1/3, 1 at x=2/3).
+HexTemplate template_adjusted_slabs(TemplateTag tag,
+                                    const std::array<std::array<double, 2>, 4>& sec,
+                                    const std::array<int, 4>& adjust_edge) {
+  TemplateBuilder b(tag);
+  auto whole = [&](double x) {
+    return std::array<int16_t, 4>{b.node(x, 0, 0), b.node(x, 1, 0), b.node(x, 1, 1),
+                                  b.node(x, 0, 1)};
+  };
+  std::array<std::array<int16_t, 4>, 2> inner;
+  for (int k = 0; k < 2; ++k) {
+    const double x = (k + 1) / 3.0;
+    for (int c = 0; c < 4; ++c)
+      inner[k][c] = adjust_edge[c] >= 0 ? b.adjustment(adjust_edge[c], k, x, sec[c][0], sec[c][1])
+                                        : b.node(x, sec[c][0], sec[c][1]);
+  }
+  b.child(whole(0), inner[0]);
+  b.child(inner[0], inner[1]);
+  b.child(inner[1], whole(1));
+  return b.take();
+}
+
+}  // namespace
+
+const HexTemplate& template_1_3_adjust1() {
+  // x-edges e0 (y0 z0), e2 (y1 z0), e4 (y0 z1) split, e6 (y1 z1) not. Faces y=0 and z=0 are 1-3
+  // faces, faces y=1 and z=1 carry 1-4 face templates whose top quads both touch e6: the
+  // adjustment (Parrish, Figure E-21) merges their transition nodes into two adjustment nodes
+  // (x, q, q) inside the hex, so the two top quads become one face shared by the neighbours
+  // across y=1 and z=1 (TemplateFaceAlias). Three slabs with section (0,0) (1,0) (q,q) (0,1).
+  static const HexTemplate t = template_adjusted_slabs(
+      TemplateTag::t1_3_adjust1,
+      {{{0, 0}, {1, 0}, {template_adjustment_depth, template_adjustment_depth}, {0, 1}}},
+      {-1, -1, 6, -1});
+  return t;
+}
+
+const HexTemplate& template_1_3_adjust2() {
+  // x-edges e0 (y0 z0) and e6 (y1 z1) split: all four side faces carry 1-4 face templates;
+  // adjustments at e2 (y1 z0: faces y=1 and z=0 merged) and at e4 (y0 z1: faces y=0 and z=1).
+  // Three slabs with section (0,0) (q,1-q) (1,1) (1-q,q).
+  const double q = template_adjustment_depth;
+  static const HexTemplate t = template_adjusted_slabs(
+      TemplateTag::t1_3_adjust2, {{{0, 0}, {q, 1 - q}, {1, 1}, {1 - q, q}}}, {-1, 2, -1, 4});
+  return t;
+}
+
+}  // namespace hexrefine
+
+namespace hexrefine {
+
+TemplateChoice template_for_mask(uint16_t mask) {
+  static const std::array<TemplateChoice, 4096> table = [] {
+    std::array<TemplateChoice, 4096> out{};
+    const HexTemplate* all[] = {&template_1_27(),       &template_1_13(), &template_1_5(),
+                                &template_1_4(),        &template_1_3(),  &template_1_3_adjust1(),
+                                &template_1_3_adjust2()};
+    for (const HexTemplate* t : all) {
+      const uint16_t canonical = template_split_edges(*t);
+      for (int s = 0; s < 48; ++s) {
+        const uint16_t m = cube_symmetry_edge_mask(cube_symmetries()[s], canonical);
+        if (!out[m].tmpl) out[m] = {t, static_cast<int8_t>(s)};
+      }
+    }
+    return out;
+  }();
+  return table[mask & 0xFFF];
 }
 
 }  // namespace hexrefine

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "algorithms/refiner.hpp"
@@ -95,6 +96,108 @@ struct TemplateApplyResult {
   int64_t hexes_deleted = 0;
 };
 
+/// Exact positions in an input hex's reference cube, in units of 1 / template_param_unit
+/// (6^10: template nodes on cell boundaries sit on a sixths grid, so three levels of sub-cells,
+/// each mapping sixths trilinearly, stay exact).
+inline constexpr int64_t template_param_unit = 60466176;
+using TemplateParam = std::array<int64_t, 3>;
+
+/// What a node subdivides, independent of the hex it is seen from: kind corner (entity = node
+/// id), edge (entity = edge id, a = position along the edge from its lower to its higher node
+/// id), face (entity = face id, (a, b) = position in the face's canonical frame: origin at its
+/// lowest node id, u towards the lower-id neighbour), interior (entity = input hex, a = x * (unit
+/// + 1) + y, b = z), adjustment (entity = edge id, a = index along the edge's global direction)
+/// and fresh (entity = node id: a node nobody else can name, e.g. an interior node off the grid).
+struct TemplateNodeKey {
+  enum Kind : int64_t { corner = 0, edge = 1, face = 2, interior = 3, adjustment = 4, fresh = 5 };
+  int64_t entity = 0;  ///< kind << 40 | id
+  int64_t a = 0, b = 0;
+  bool operator==(const TemplateNodeKey& o) const {
+    return entity == o.entity && a == o.a && b == o.b;
+  }
+  Kind kind() const { return static_cast<Kind>(entity >> 40); }
+};
+
+struct TemplateNodeKeyHash {
+  size_t operator()(const TemplateNodeKey& k) const {
+    uint64_t h = static_cast<uint64_t>(k.entity) * 0x9E3779B97F4A7C15ull;
+    h ^= static_cast<uint64_t>(k.a) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+    h ^= static_cast<uint64_t>(k.b) + 0x94D049BB133111EBull + (h << 6) + (h >> 2);
+    return static_cast<size_t>(h);
+  }
+};
+
+/// A cell to refine: the whole input hex `hex`, or a sub-hex of it produced by earlier steps of
+/// directional refinement. Corners carry their output node ids, their exact reference positions
+/// in `hex`'s cube and their keys.
+struct TemplateCell {
+  int32_t hex = -1;
+  HexCell nodes{};
+  std::array<TemplateParam, 8> param{};
+  std::array<TemplateNodeKey, 8> key{};
+  /// Local axis k of this cell runs along axis axis[k] of the input hex.
+  std::array<int8_t, 3> axis = {0, 1, 2};
+  bool whole = true;       ///< the input hex itself
+  bool exact = true;       ///< every corner's param is exact (else it cannot be refined further)
+  bool collapsed = false;  ///< a corner was redirected onto an adjustment node by a face alias
+};
+
+/// The one generic routine behind every template application: maps template nodes through a
+/// cell's frame to exact positions in its input hex, keys them by what they subdivide and
+/// shares them through a hash table, so that any two cells (of the same or of neighbouring input
+/// hexes) that name the same edge or face position get the same node. Positions come from the
+/// input hex's trilinear map. Adjustment nodes are positioned by their owner (the cell whose
+/// template has them), overriding a provisional position set through an alias.
+class TemplateRefiner {
+ public:
+  /// `mesh` and `topology` must outlive the refiner; output points start as a copy of the input's.
+  TemplateRefiner(const HexMesh& mesh, const HexTopology& topology);
+
+  /// The cell of a whole input hex.
+  TemplateCell cell_whole(int32_t hex) const;
+
+  /// Key of the exact point `p` of input hex `hex`'s reference cube.
+  TemplateNodeKey key_at(int32_t hex, const TemplateParam& p) const;
+
+  /// Key of adjustment node `k` (in the edge's global direction) of edge `edge`.
+  static TemplateNodeKey key_adjustment(int32_t edge, int k);
+
+  /// Nodes named `from` are the node named `to` from now on. Returns false (and changes nothing)
+  /// if `from` already names a different node: two adjustments would collapse one face.
+  bool alias(const TemplateNodeKey& from, const TemplateNodeKey& to);
+
+  /// Applies `tmpl` in orientation `symmetry` to `cell` and appends its children to `children`
+  /// (their keys, params and axes filled in). Throws OperationError if the cell cannot be refined
+  /// (inexact corners, or sub-cells nested too deep for exact positions).
+  /// `node_keys`, if given, receives the key each template node was placed under (before
+  /// aliasing), indexed like tmpl.nodes.
+  void apply(const TemplateCell& cell, const HexTemplate& tmpl, int symmetry,
+             std::vector<TemplateCell>& children,
+             std::vector<TemplateNodeKey>* node_keys = nullptr);
+
+  /// Key of the template node `node` (with its position `local_ref` in the cell's frame, i.e.
+  /// already mapped by the symmetry) as apply() would place it; throws OperationError if the
+  /// position is not exact.
+  TemplateNodeKey key_of_template_node(const TemplateCell& cell, int symmetry,
+                                       const TemplateNode& node) const;
+
+  /// Key of every node created so far, indexed by node id - input point count.
+  const std::vector<TemplateNodeKey>& created_keys() const { return created_keys_; }
+
+  /// Output points (input points first, then every node created).
+  const std::vector<Eigen::Vector3d>& points() const { return points_; }
+  std::vector<Eigen::Vector3d>& points() { return points_; }
+
+ private:
+  int32_t node_of(const TemplateNodeKey& key, const Eigen::Vector3d& x, bool* aliased);
+  const HexMesh& mesh_;
+  const HexTopology& topology_;
+  std::vector<Eigen::Vector3d> points_;
+  std::vector<TemplateNodeKey> created_keys_;
+  std::unordered_map<TemplateNodeKey, int32_t, TemplateNodeKeyHash> nodes_;
+  std::unordered_map<TemplateNodeKey, TemplateNodeKey, TemplateNodeKeyHash> aliases_;
+};
+
 /// Applies every template application to its hex at once and returns the new mesh: untouched
 /// hexes are copied, refined hexes are replaced by their children, in input hex order (so the
 /// output is deterministic). Output attributes: those of the input, inherited by children;
@@ -116,6 +219,31 @@ const HexTemplate& template_1_3();
 const HexTemplate& template_1_4();
 /// 1-5: one edge split (e0); faces y=0 and z=0 carry 1-4 face templates; 5 children.
 const HexTemplate& template_1_5();
+/// 1-13: the four edges of face z=0 split (e0..e3); 13 children.
+const HexTemplate& template_1_13();
+/// 1-3 with one adjustment: e0 e2 e4 split, e6 not; adjustment nodes on e6; 3 children.
+const HexTemplate& template_1_3_adjust1();
+/// 1-3 with two adjustments: e0 e6 split; adjustment nodes on e2 and e4; 3 children.
+const HexTemplate& template_1_3_adjust2();
+
+/// 1-13 with its four interior nodes at height `interior_height` in (0, 1) (for quality scans).
+HexTemplate template_1_13_build(double interior_height);
+/// Height of the four interior nodes of 1-13. The minimum scaled Jacobian is 4/13 = 0.3077 (the
+/// thesis' L-shaped value) for every height in (0, 0.27], fixed by the corner children; above
+/// that it drops (0.5 is degenerate). 1/6 lies inside the plateau and on the sixths grid.
+inline constexpr double template_1_13_interior_height = 1.0 / 6.0;
+/// Depth q of adjustment nodes: (x, q, q) for an adjustment at edge (y1, z1). A multiple of 1/6
+/// so that sub-hexes of directional refinement keep exact reference positions.
+inline constexpr double template_adjustment_depth = 5.0 / 6.0;
+
+/// The template and symmetry for a split-edge mask (bit e = local edge e split), from a table
+/// precomputed over the seven templates and 48 symmetries; tmpl is nullptr for mask 0 and for
+/// masks no template matches (those hexes need directional refinement).
+struct TemplateChoice {
+  const HexTemplate* tmpl = nullptr;
+  int8_t symmetry = 0;
+};
+TemplateChoice template_for_mask(uint16_t mask);
 
 /// Checks a template on the unit cube: every child has positive scaled Jacobian, children fill the
 /// cube (volumes sum to 1), and no face is shared by more than two children. Returns the minimum

@@ -44,19 +44,24 @@ double quad_area(const Quad& q) {
   return area;
 }
 
-/// Out-of-plane spread of the four corners (along the normal of the diagonals) over the diameter.
-double quad_relative_warp(const Quad& q) {
-  const double diameter = quad_diameter(q);
+/// Out-of-plane spread of the four corners along the normal of the diagonals (0 if degenerate).
+double quad_warp(const Quad& q) {
   const Eigen::Vector3d n = (q[2] - q[0]).cross(q[3] - q[1]);
   const double n_norm = n.norm();
-  if (!(n_norm > 0.0) || !(diameter > 0.0)) return 0.0;  // degenerate: collinear points are planar
+  if (!(n_norm > 0.0)) return 0.0;  // collinear diagonals: the points span no plane to leave
   double lo = 0.0, hi = 0.0;
   for (int i = 1; i < 4; ++i) {
     const double d = (q[i] - q[0]).dot(n) / n_norm;
     lo = std::min(lo, d);
     hi = std::max(hi, d);
   }
-  return (hi - lo) / diameter;
+  return hi - lo;
+}
+
+/// quad_warp over the diameter.
+double quad_relative_warp(const Quad& q) {
+  const double diameter = quad_diameter(q);
+  return diameter > 0.0 ? quad_warp(q) / diameter : 0.0;
 }
 
 /// Distance from p to the bilinear patch q, by Gauss-Newton on (u, v) clamped to [0,1]^2. Exact
@@ -193,7 +198,10 @@ BoundarySurface boundary_surface(const HexMesh& mesh, const HexTopology& t) {
     const auto& n = t.face_nodes[f];
     s.nodes.push_back(n);
     s.quads.push_back({mesh.points[n[0]], mesh.points[n[1]], mesh.points[n[2]], mesh.points[n[3]]});
-    s.tolerances.push_back(mesh_check_surface_tolerance * quad_diameter(s.quads.back()));
+    // A point averaged from patch points (a sub-face centroid, a node placed by a template whose
+    // footprint is not a parameter rectangle) can leave a warped patch by up to its warp.
+    s.tolerances.push_back(mesh_check_surface_tolerance * quad_diameter(s.quads.back()) +
+                           quad_warp(s.quads.back()));
   }
   return s;
 }

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <map>
 #include <set>
 
 #include "mesh/error.hpp"
@@ -141,6 +143,60 @@ TEST(Templates, FacesMatchTheFaceTemplates) {
   EXPECT_EQ(template_faces_check(template_1_3()), 6);
   EXPECT_EQ(template_faces_check(template_1_4()), 6);
   EXPECT_EQ(template_faces_check(template_1_5()), 6);
+}
+
+TEST(Templates, OneThirteenAndAdjustedTemplates) {
+  EXPECT_EQ(template_1_13().children.size(), 13u);
+  EXPECT_EQ(template_1_3_adjust1().children.size(), 3u);
+  EXPECT_EQ(template_1_3_adjust2().children.size(), 3u);
+  EXPECT_EQ(template_split_edges(template_1_13()), 0xF);
+  EXPECT_EQ(template_split_edges(template_1_3_adjust1()), (1 << 0) | (1 << 2) | (1 << 4));
+  EXPECT_EQ(template_split_edges(template_1_3_adjust2()), (1 << 0) | (1 << 6));
+  const double sj13 = template_validate(template_1_13());
+  EXPECT_NEAR(sj13, 0.3077, 1e-4);  // the thesis' L-shaped minimum
+  EXPECT_NEAR(template_validate(template_1_3_adjust1()), 0.7537, 1e-4);
+  EXPECT_GT(template_validate(template_1_3_adjust2()), 0.3077);
+  EXPECT_EQ(template_faces_check(template_1_13()), 6);
+  // The merged faces (y=1, z=1 for one adjustment; all four sides for two) are checked by the
+  // conformity tests of templates_apply with face aliases.
+  EXPECT_EQ(template_faces_check(template_1_3_adjust1(), {3, 5}), 4);
+  EXPECT_EQ(template_faces_check(template_1_3_adjust2(), {2, 3, 4, 5}), 2);
+}
+
+TEST(Templates, OneThirteenInteriorHeightIsTheBestOfAScan) {
+  double best = -1;
+  for (int i = 1; i < 60; ++i) {
+    double sj = -1;
+    try {
+      sj = template_validate(template_1_13_build(i / 60.0));
+    } catch (const OperationError&) {
+    }
+    best = std::max(best, sj);
+  }
+  EXPECT_NEAR(best, 4.0 / 13.0, 1e-4);
+  EXPECT_NEAR(template_validate(template_1_13()), best, 1e-12);
+}
+
+TEST(Templates, MaskTableCoversTheSevenPatternsUnderAllSymmetries) {
+  int covered = 0;
+  std::map<TemplateTag, int> per_tag;
+  for (int m = 1; m < 4096; ++m) {
+    const TemplateChoice c = template_for_mask(static_cast<uint16_t>(m));
+    if (!c.tmpl) continue;
+    ++covered;
+    ++per_tag[c.tmpl->tag];
+    EXPECT_EQ(cube_symmetry_edge_mask(cube_symmetries()[c.symmetry], template_split_edges(*c.tmpl)),
+              m);
+  }
+  EXPECT_EQ(per_tag[TemplateTag::t1_27], 1);
+  EXPECT_EQ(per_tag[TemplateTag::t1_13], 6);          // one per face
+  EXPECT_EQ(per_tag[TemplateTag::t1_5], 12);          // one per edge
+  EXPECT_EQ(per_tag[TemplateTag::t1_4], 6 * 2);       // two parallel edge pairs per face
+  EXPECT_EQ(per_tag[TemplateTag::t1_3], 3);           // one per direction
+  EXPECT_EQ(per_tag[TemplateTag::t1_3_adjust1], 12);  // three of four parallel edges
+  EXPECT_EQ(per_tag[TemplateTag::t1_3_adjust2], 6);   // a diagonal pair per direction
+  EXPECT_EQ(covered, 1 + 6 + 12 + 12 + 3 + 12 + 6);
+  EXPECT_EQ(template_for_mask(0).tmpl, nullptr);
 }
 
 TEST(Templates, ValidateRejectsAnInvertedChild) {

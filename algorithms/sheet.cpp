@@ -12,18 +12,24 @@
 //     a directional template: four split -> 1-3, two on one face -> 1-4, one -> 1-5. Three, or
 //     two diagonal, would need an adjustment template Harris did not have: the hex is a
 //     multiply-connected transition. It is decided per hex and direction from the node marks
-//     on the original mesh; each such hex is added to the targets (its nodes marked) until none
-//     is left (worklist over the hexes around newly marked nodes).
+//     on the original mesh; all such hexes are added to the targets (their nodes marked) in
+//     waves until none is left (each wave looks only at the hexes around newly marked nodes).
+//     A hex all of whose nodes get marked is fully refined without being counted as added.
 //  3. Sheets. Only hexes with a split edge change. On the original mesh the dual is walked from
 //     those hexes: the split edges of one direction of one hex are parallel, so they belong to
 //     one dual sheet; a union-find over the split edges gives the connected pieces of the dual
 //     sheets that must be refined (a sheet pass refines one such piece: all hexes around each
 //     split edge at once, which keeps the mesh conformal). A piece that occupies two directions
-//     of one hex is a sheet crossing itself where it must refine: refused (OperationError naming
-//     the sheet and the hexes). Pieces are coloured first-fit so that no two pieces of one
-//     colour share a hex; one colour is one round, and processing the pieces of one round
-//     together is the same as processing them one after the other, since they share no hex.
-//     For a structured brick the rounds are the x-, y- and z-like sheets.
+//     of one hex is a sheet crossing itself where it must refine (Harris' special case): if all
+//     edges of the hex are split, the pass refines both directions at once with the composite
+//     1-9 template (1-3 across one direction then the other, as one template; 1-27 for three);
+//     otherwise a transition template for two directions would be needed, and the case is
+//     refused (OperationError naming the sheet and the hexes). The dual sheets that cross
+//     themselves in a refined hex are counted (self_intersection_cases, per hex).
+//     Pieces are coloured first-fit so that no two pieces of one colour share a hex; one colour
+//     is one round, and processing the pieces of one round together is the same as processing
+//     them one after the other, since they share no hex (sheet_passes counts the pieces). For a
+//     structured brick the rounds are the x-, y- and z-like sheets.
 //  4. Rounds. The refined region (the hexes with a split edge) is copied with compact node ids
 //     and refined round by round with the directional templates (templates_apply). Every output
 //     hex carries, per local axis, the sheet piece it still has to be refined in; a child's axis
@@ -32,7 +38,12 @@
 //     inside a split edge are marked (so the strips of a 1-3 face are split in the next
 //     direction); new face and interior nodes are not. A fully refined hex goes
 //     1 -> 3 -> 9 -> 27 (13 deleted, 39 created, thesis 4.3).
-//  5. Assembly: the untouched hexes and the refined region in input hex order.
+//  5. Assembly: the untouched hexes and the refined region in input hex order. Every refined
+//     hex is tagged TemplateTag::sheet, its refinement level one above its input hex's.
+// Options: `passes` repeats the whole on the descendants of the given targets; the selective
+// refiner's options (ranking, propagation, ebe_only, buffer) do not apply and are ignored.
+// A safety check before every round makes sure all hexes around each split edge split it in
+// that round (OperationError otherwise), so a result is conformal by construction.
 //
 // Speed: every step is linear in the size of the refined region (plus one copy of the mesh and
 // one pass over its edges for the dual sheet labels); there is no rescan of the mesh per sheet.
@@ -84,7 +95,7 @@ bool edges_share_face(int a, int b) {
 struct Orientation {
   const HexTemplate* tmpl = nullptr;
   int8_t symmetry = 0;
-  int8_t axis = 0;  // the parent local axis this orientation refines
+  uint8_t axes = 0;  // bit k: refines parent local axis k (two or three bits for 1-9, 1-27)
   std::vector<std::array<int8_t, 3>> child_axis;
   std::vector<uint8_t> child_edge_nodes;
 };
@@ -94,9 +105,31 @@ struct DirectionalTable {
   std::array<int16_t, 4096> by_mask{};  // split mask (edges of one axis) -> orientation, or -1
 };
 
+// 1-9: the x- and y-parallel edges split, 3 x 3 columns: 1-3 across x then across y, as one
+// template. Used where a dual sheet crosses itself in a fully marked hex (Harris' special case:
+// the hex is refined in its two directions of that sheet within the sheet's pass).
+const HexTemplate& sheet_template_1_9() {
+  static const HexTemplate t = [] {
+    HexTemplate r;
+    r.tag = TemplateTag::sheet;
+    auto id = [](int i, int j, int k) { return static_cast<int16_t>(i + 4 * (j + 4 * k)); };
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) r.nodes.push_back({{i / 3.0, j / 3.0, double(k)}});
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i)
+        r.children.push_back({id(i, j, 0), id(i + 1, j, 0), id(i + 1, j + 1, 0), id(i, j + 1, 0),
+                              id(i, j, 1), id(i + 1, j, 1), id(i + 1, j + 1, 1), id(i, j + 1, 1)});
+    return r;
+  }();
+  return t;
+}
+
+// The directional templates (one direction) and the composites for self-intersecting sheets
+// (two directions: 1-9; three: 1-27). Their split masks never coincide.
 const std::vector<const HexTemplate*>& directional_templates() {
-  static const std::vector<const HexTemplate*> list = {&template_1_3(), &template_1_4(),
-                                                       &template_1_5()};
+  static const std::vector<const HexTemplate*> list = {
+      &template_1_3(), &template_1_4(), &template_1_5(), &sheet_template_1_9(), &template_1_27()};
   return list;
 }
 
@@ -110,7 +143,8 @@ Orientation orientation_make(const HexTemplate& t, int s) {
   o.tmpl = &t;
   o.symmetry = static_cast<int8_t>(s);
   const uint16_t mask = cube_symmetry_edge_mask(sym, template_split_edges(t));
-  o.axis = static_cast<int8_t>(hex_edge_axis[std::countr_zero(mask)]);
+  for (int e = 0; e < 12; ++e)
+    if (mask & (1u << e)) o.axes |= static_cast<uint8_t>(1u << hex_edge_axis[e]);
   for (const auto& child : t.children) {
     std::array<std::array<double, 3>, 8> p{};
     for (int j = 0; j < 8; ++j) {
@@ -140,6 +174,9 @@ Orientation orientation_make(const HexTemplate& t, int s) {
         if (std::abs(p[j][c]) < kSnap || std::abs(p[j][c] - 1.0) < kSnap) ++extreme;
       if (extreme == 2) edge_nodes |= static_cast<uint8_t>(1u << j);
     }
+    // A composite (1-9, 1-27) is the sequence of 1-3s in a fully marked hex: there, every
+    // node lies on a split edge of an intermediate hex and is marked.
+    if (std::popcount(o.axes) > 1) edge_nodes = 0xFF;
     o.child_axis.push_back(axes);
     o.child_edge_nodes.push_back(edge_nodes);
   }
@@ -333,7 +370,7 @@ std::string hex_list(const std::vector<int32_t>& hexes) {
 
 // One refinement of `targets` of `mesh`; statistics are accumulated into `stats`.
 PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
-                       const SheetRoundObserver* observer, RefineStats& stats) {
+                       const SheetControl& control, RefineStats& stats) {
   const auto t_start = Clock::now();
   const HexTopology topology = topology_build(mesh);
   SheetMarking marking;
@@ -426,6 +463,8 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
         s[k] = sheets.find(topology.hex_edge_ids[h][hex_axis_edges[k][0]]);
       if (s[0] == s[1] || s[1] == s[2] || s[0] == s[2]) ++stats.self_intersection_cases;
       const auto& o = region.occurrence[i];
+      // All edges split: the piece's directions are refined together by 1-9 (or 1-27).
+      if (hex_split_mask(mesh, marking.node_marked, h) == 0xFFF) continue;
       for (int a = 0; a < 3; ++a)
         for (int b = a + 1; b < 3; ++b)
           if (o[a] >= 0 && o[a] == o[b]) {
@@ -438,8 +477,9 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
       throw OperationError(
           "sheet refinement: the dual sheet of edge " + edge_name(piece_edge[refused_piece]) +
           " crosses itself in hexes " + hex_list(refused) +
-          ", which it must refine in two directions within one sheet pass; self-intersecting "
-          "sheets are not handled by the sheet refiner (the selective refiner handles them)");
+          ", which it must refine in two directions within one sheet pass with transition "
+          "templates; that case of a self-intersecting sheet is not handled by the sheet refiner "
+          "(only fully refined hexes are: 1-9)");
   }
 
   // Rounds: first-fit colouring of the pieces; two pieces conflict when they share a hex.
@@ -471,6 +511,11 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
       color[p] = c;
       round_count = std::max(round_count, c + 1);
     }
+  }
+
+  if (control.one_sheet_per_round) {
+    std::iota(color.begin(), color.end(), 0);
+    round_count = piece_count;
   }
 
   // The region with compact node ids.
@@ -505,50 +550,54 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
     const HexTopology rt = topology_build(cur);
     std::vector<TemplateApplication> apps;
     std::vector<int16_t> orientation_of(count, -1);
-    std::vector<int8_t> axis_of(count, -1);
+    std::vector<uint8_t> axes_of(count, 0);  // axes refined in this round
     for (int32_t h = 0; h < count; ++h) {
       auto& occ = region.occurrence[h];
+      uint8_t axes = 0;
+      int32_t piece = -1;
       for (int k = 0; k < 3; ++k) {
         if (occ[k] < 0 || color[occ[k]] != round) continue;
-        if (axis_of[h] >= 0)
+        // Two pieces of one colour never share a hex; one piece twice is a self-intersection.
+        if (piece >= 0 && occ[k] != piece)
           throw OperationError("sheet refinement: a hex descending from input hex " +
                                std::to_string(region.origin[h]) +
                                " would be refined in two directions in one round (sheets of "
                                "edges " +
-                               edge_name(piece_edge[occ[axis_of[h]]]) + " and " +
+                               edge_name(piece_edge[piece]) + " and " +
                                edge_name(piece_edge[occ[k]]) + ")");
-        axis_of[h] = static_cast<int8_t>(k);
+        piece = occ[k];
+        axes |= static_cast<uint8_t>(1u << k);
       }
-      if (axis_of[h] < 0) continue;
-      const int k = axis_of[h];
-      const uint16_t split = hex_split_mask(cur, region.node_marked, h) & axis_mask(k);
-      const int32_t piece = occ[k];
-      occ[k] = -1;
-      if (!split) {
-        axis_of[h] = -1;
-        continue;
-      }
+      if (!axes) continue;
+      uint16_t wanted = 0;
+      for (int k = 0; k < 3; ++k)
+        if (axes & (1u << k)) {
+          wanted |= axis_mask(k);
+          occ[k] = -1;
+        }
+      const uint16_t split = hex_split_mask(cur, region.node_marked, h) & wanted;
+      if (!split) continue;
       const int16_t o = table.by_mask[split];
       if (o < 0)
         throw OperationError("sheet refinement: a hex descending from input hex " +
                              std::to_string(region.origin[h]) +
                              " has a split pattern with no directional template (" +
-                             std::to_string(std::popcount(split)) +
-                             " parallel edges split) in the sheet of edge " +
-                             edge_name(piece_edge[piece]));
+                             std::to_string(std::popcount(split)) + " edges split in " +
+                             std::to_string(std::popcount(axes)) +
+                             " directions) in the sheet of edge " + edge_name(piece_edge[piece]));
       orientation_of[h] = o;
+      axes_of[h] = table.orientations[o].axes;
       apps.push_back({h, table.orientations[o].tmpl, table.orientations[o].symmetry});
     }
     // Conformity by construction needs every hex around a split edge to split it in this round.
     for (const TemplateApplication& a : apps) {
-      const int k = axis_of[a.hex];
-      const uint16_t split = hex_split_mask(cur, region.node_marked, a.hex) & axis_mask(k);
-      for (int e : hex_axis_edges[k]) {
-        if (!(split & (1u << e))) continue;
+      const uint16_t split = hex_split_mask(cur, region.node_marked, a.hex);
+      for (int e = 0; e < 12; ++e) {
+        if (!(split & (1u << e)) || !(axes_of[a.hex] & (1u << hex_edge_axis[e]))) continue;
         const int32_t id = rt.hex_edge_ids[a.hex][e];
         for (int32_t g : edge_hexes(rt, id)) {
           const int le = hex_local_edge(rt, g, id);
-          if (axis_of[g] < 0 || hex_edge_axis[le] != axis_of[g])
+          if (!(axes_of[g] & (1u << hex_edge_axis[le])))
             throw OperationError("sheet refinement: hexes descending from input hexes " +
                                  std::to_string(region.origin[a.hex]) + " and " +
                                  std::to_string(region.origin[g]) +
@@ -581,6 +630,7 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
       }
       const Orientation& orient = table.orientations[o];
       for (int k = 0; k < 3; ++k) {
+        // The parent's refined axes were set to -1 above: children are done in them.
         const int p = orient.child_axis[child][k];
         occurrence[i][k] = p < 0 ? -1 : region.occurrence[parent][p];
       }
@@ -593,7 +643,7 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
     region.occurrence = std::move(occurrence);
     region.origin = std::move(origin);
     region.node_marked = std::move(marked);
-    if (observer && *observer) (*observer)(region_assemble(mesh, affected, region).mesh, round);
+    if (control.observer) control.observer(region_assemble(mesh, affected, region).mesh, round);
   }
 
   if (!options.allow_inverted)
@@ -656,6 +706,13 @@ RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets,
 
 RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
                           const SheetRoundObserver& observer) {
+  SheetControl control;
+  control.observer = observer;
+  return sheet_refine(mesh, targets, options, control);
+}
+
+RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
+                          const SheetControl& control) {
   targets_validate(mesh, targets);
   if (options.passes < 1)
     throw InputError("sheet refinement: passes must be at least 1 (got " +
@@ -670,7 +727,7 @@ RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const Ref
   PassOutput current{mesh, {}};
   Targets pass_targets = targets;
   for (int pass = 0; pass < options.passes; ++pass) {
-    PassOutput next = refine_once(current.mesh, pass_targets, options, &observer, stats);
+    PassOutput next = refine_once(current.mesh, pass_targets, options, control, stats);
     if (pass + 1 < options.passes) {
       // The next pass refines the descendants of this pass's (given) targets.
       std::vector<uint8_t> was_target(current.mesh.hexes.size(), 0);

@@ -56,14 +56,28 @@ using SheetRoundObserver = std::function<void(const HexMesh& mesh, int round)>;
 /// Refines `targets` of `mesh` one direction at a time, sheet by sheet. Output attributes:
 /// those of the input, inherited; "template_tag" = TemplateTag::sheet on every hex produced by
 /// sheet passes (untouched hexes keep theirs, or 0); "refinement_level" = the parent's + 1 per
-/// pass (options.passes). Throws InputError for invalid targets, OperationError naming the
-/// sheet and hexes for a case it refuses (a sheet crossing itself in a hex that it must refine
-/// in two directions): never returns a non-conformal mesh.
+/// pass (options.passes). A dual sheet crossing itself in a fully refined hex is handled (both
+/// directions in one pass, template 1-9); stats.self_intersection_cases counts the refined hexes
+/// a dual sheet crosses itself in. Throws InputError for invalid targets, OperationError naming
+/// the sheet and hexes for a case it refuses (a sheet crossing itself in a transition hex that
+/// it must refine in two directions): never returns a non-conformal mesh.
 RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets,
                           const RefineOptions& options);
 
 /// As above, with an observer of the intermediate meshes.
 RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
                           const SheetRoundObserver& observer);
+
+/// How the sheet passes are scheduled and watched (tests, figures, studies).
+struct SheetControl {
+  SheetRoundObserver observer;  ///< called after every round, if set
+  /// Harris' order: one sheet piece per round, in piece order, instead of all the pieces that
+  /// share no hex together. Same result; one copy of the refined region per sheet (slower).
+  bool one_sheet_per_round = false;
+};
+
+/// As above, with a schedule and an observer.
+RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
+                          const SheetControl& control);
 
 }  // namespace hexrefine

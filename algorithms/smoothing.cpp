@@ -9,29 +9,35 @@
 /// - P. M. Knupp, "Algebraic mesh quality metrics", SIAM J. Sci. Comput. 23 (2001) 193-218: the
 ///   mean ratio of a corner matrix A against the identity, |A|_F^2 / (3 det(A)^(2/3)) in its
 ///   inverse form (1 for a scaled rotation, growing without bound as det(A) -> 0+).
-/// - L. Freitag, M. Jones, P. Plassmann, "An efficient parallel algorithm for mesh smoothing"
-///   (IMR 1995) and the "smart" Laplacian idea: a Laplacian move is kept only if it does not make
-///   the local quality worse; local optimisation that maximises the minimum quality around a node.
+/// - L. A. Freitag, "On combining Laplacian and optimization-based mesh smoothing techniques",
+///   AMD Trends in Unstructured Mesh Generation 220 (1997) 37-43: "smart" Laplacian (a move is
+///   kept only if the local quality does not get worse) and optimisation of the minimum quality
+///   around a node only where the cheap Laplacian move does not suffice.
 ///
 /// Steps of mesh_smooth:
-///  1. Classify nodes from the boundary faces around them (interior, planar, curved, feature);
-///     movable nodes are the interior and planar nodes of the region hexes.
-///  2. Per sweep, order the movable nodes worst-first (lowest scaled Jacobian of their hexes) by a
-///     counting sort on the quantised quality (ties by node id: deterministic, linear time).
-///  3. Visit each node (Gauss-Seidel: moves are seen at once by later nodes):
-///     - laplacian: the mean of the edge neighbours (projected onto the plane for planar nodes);
-///       full, half or quarter move kept if the guard holds.
-///     - optimize: (a) a few damped Newton steps on the sum of inverse mean ratios of the corner
-///       matrices that depend on the node (analytic gradient, Hessian by differences of the
-///       gradient, eigenvalues clamped positive), kept if the guard holds; then (b) ascent of a
+///  1. Classify nodes from the boundary faces around them (mesh_classify_smooth_nodes: interior,
+///     planar, curved, feature); the movable nodes are the interior and planar nodes of the region
+///     hexes. All of them are active for the first sweep.
+///  2. Per sweep, order the active movable nodes worst-first (lowest scaled Jacobian of their
+///     hexes) by a counting sort on the quantised quality (ties by node id: deterministic, linear).
+///  3. Visit each node (Gauss-Seidel: moves are seen at once by later nodes). Every candidate
+///     position (projected onto the plane for planar nodes) goes through one rule, the guard:
+///     no hex with a positive scaled Jacobian becomes non-positive, every hex around the node stays
+///     >= the node's current local minimum, and the local minimum or the sum of the scaled
+///     Jacobians around the node rises. Hexes elsewhere are unchanged, hence the mesh minimum never
+///     decreases, and a mesh that cannot be improved (e.g. perfect boxes) is left as it is.
+///     - laplacian: the mean of the edge neighbours, tried as a full, half and quarter move.
+///     - optimize: (a) the Laplacian candidate (cheap, and it untangles where (b) cannot start);
+///       (b) one damped Newton step on the sum of inverse mean ratios of the corner matrices that
+///       depend on the node (analytic gradient, Hessian by differences of the gradient, eigenvalues
+///       clamped positive, backtracking while the sum does not fall); (c) three ascent steps on a
 ///       soft minimum of the scaled-Jacobian samples of the hexes around the node
 ///       (central-difference gradient, backtracking until the true local minimum rises), which
 ///       targets exactly the quantity the thesis reports.
-///     The guard: every hex around the node keeps a scaled Jacobian >= the node's current local
-///     minimum, and no hex with a positive value becomes non-positive. Hexes elsewhere are
-///     unchanged, hence the mesh minimum never decreases.
-///  4. Stop after max_sweeps or when a sweep moves no node by more than 1e-7 of its local edge
-///     length, or improves neither the minimum (by 1e-9) nor the mean (by 1e-6).
+///     Nodes of the hexes around a node that moved become active for the next sweep.
+///  4. Stop after max_sweeps, when no node is active, or when a sweep moves no node by more than
+///     1e-7 of its local edge length or improves neither the minimum (by 1e-9) nor the mean (by
+///     1e-6).
 
 #include "algorithms/smoothing.hpp"
 
@@ -136,6 +142,9 @@ class Smoother {
     if (method_ == SmoothMethod::laplacian) {
       node_laplacian(n);
     } else {
+      // The Laplacian candidate is cheap and untangles where the barrier objective cannot start
+      // (an inverted corner makes the mean ratio infinite).
+      node_laplacian(n);
       node_mean_ratio_newton(n);
       node_min_ascent(n);
     }
@@ -205,17 +214,19 @@ class Smoother {
     for (int32_t h : node_hexes(topology_, n)) quality_[h] = trial_quality_[i++];
   }
 
-  /// Tries x0 + t (x - x0) for t = 1, 1/2, 1/4 and keeps the first that passes the guard with a
-  /// local minimum >= `floor` (and, if `require_gain`, a larger sum of the scaled Jacobians around
-  /// n). Returns true if a move was made.
-  bool node_try_towards(int32_t n, const Vec3& x, double floor, bool require_gain) {
+  /// Tries x0 + t (x - x0) for t = 1, 1/2, 1/4 and keeps the first that passes the guard and
+  /// improves: the local minimum does not drop and either it or the sum of the scaled Jacobians
+  /// around n rises (so a mesh of perfect boxes, graded or not, is left as it is). Returns true
+  /// if a move was made.
+  bool node_try_towards(int32_t n, const Vec3& x) {
     const Vec3 x0 = mesh_.points[n];
+    const double floor = node_local_min(n);
     for (double t : {1.0, 0.5, 0.25}) {
       const Vec3 candidate = node_constrain(n, x0 + t * (x - x0));
       if (candidate == x0) return false;
       double local_min, gain;
       if (node_trial(n, candidate, local_min, &gain) && local_min >= floor &&
-          (!require_gain || gain > 1e-12)) {
+          (local_min > floor + 1e-12 || gain > 1e-12)) {
         node_commit(n, candidate);
         return true;
       }
@@ -229,7 +240,7 @@ class Smoother {
     Vec3 target = Vec3::Zero();
     for (int32_t i = b; i < e; ++i) target += mesh_.points[neighbours_[i]];
     target /= static_cast<double>(e - b);
-    node_try_towards(n, target, node_local_min(n), false);
+    node_try_towards(n, target);
   }
 
   /// Sum of inverse mean ratios |A|_F^2 / (3 det(A)^(2/3)) over the corner matrices that depend
@@ -287,7 +298,7 @@ class Smoother {
     double value = node_mean_ratio(n, x, &gradient);
     if (!std::isfinite(value)) return;  // an inverted corner: the ascent below untangles
     const double delta = 1e-6 * scale;
-    for (int iteration = 0; iteration < 4; ++iteration) {
+    for (int iteration = 0; iteration < newton_iterations; ++iteration) {
       const Vec3 g = projector * gradient;
       if (g.norm() * scale <= 1e-12 * value) break;
       Mat3 hessian;
@@ -327,9 +338,7 @@ class Smoother {
       gradient = next_gradient;
       if (t * step.norm() < 1e-10 * scale) break;
     }
-    // The mean ratio's ideal is a cube; a graded mesh of perfect boxes should stay as it is, so
-    // the step must also raise the scaled Jacobians around n on the whole.
-    if (x != x0) node_try_towards(n, x, node_local_min(n), true);
+    if (x != x0) node_try_towards(n, x);
   }
 
   /// Soft minimum m - log(sum exp(-beta (s - m))) / beta of the scaled-Jacobian samples of the
@@ -368,7 +377,7 @@ class Smoother {
     }
     const double delta = 1e-6 * scale;
     double step = 0.05 * scale;
-    for (int iteration = 0; iteration < 6; ++iteration) {
+    for (int iteration = 0; iteration < ascent_iterations; ++iteration) {
       const Vec3 x = mesh_.points[n];
       Vec3 gradient = Vec3::Zero();
       for (int k = 0; k < direction_count; ++k) {
@@ -394,6 +403,9 @@ class Smoother {
     }
   }
 
+  // One Newton step and three ascent steps per visit: the sweeps iterate anyway, and a neighbour
+  // that moves changes the local problem, so converging each visit fully is wasted work.
+  static constexpr int newton_iterations = 1, ascent_iterations = 3;
   HexMesh& mesh_;
   const HexTopology& topology_;
   const SmoothNodeClasses& classes_;
@@ -508,24 +520,38 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
   double current_min = stats.min_scaled_jacobian_before, current_mean = stats.mean_before;
 
   // Worst-first order by a counting sort on the quantised local minimum (linear, stable by id).
+  // Only active nodes are visited: those whose hexes changed since their last visit.
   constexpr int buckets = 4096;
-  std::vector<int32_t> bucket_offsets(buckets + 1), order(movable.size()), keys(movable.size());
-  for (int sweep = 0; sweep < options.max_sweeps && !movable.empty(); ++sweep) {
+  std::vector<int32_t> bucket_offsets(buckets + 1), order, keys;
+  std::vector<char> active(mesh.points.size(), 0), next_active(mesh.points.size(), 0);
+  for (int32_t n : movable) active[n] = 1;
+  for (int sweep = 0; sweep < options.max_sweeps; ++sweep) {
     std::fill(bucket_offsets.begin(), bucket_offsets.end(), 0);
-    for (size_t i = 0; i < movable.size(); ++i) {
-      const double q = std::clamp(smoother.node_local_min(movable[i]), -1.0, 1.0);
-      keys[i] = std::min(buckets - 1, static_cast<int>((q + 1.0) * 0.5 * buckets));
-      ++bucket_offsets[keys[i] + 1];
+    keys.clear();
+    for (int32_t n : movable) {
+      if (!active[n]) continue;
+      const double q = std::clamp(smoother.node_local_min(n), -1.0, 1.0);
+      keys.push_back(std::min(buckets - 1, static_cast<int>((q + 1.0) * 0.5 * buckets)));
+      ++bucket_offsets[keys.back() + 1];
     }
+    if (keys.empty()) break;
     for (int b = 0; b < buckets; ++b) bucket_offsets[b + 1] += bucket_offsets[b];
-    for (size_t i = 0; i < movable.size(); ++i) order[bucket_offsets[keys[i]]++] = movable[i];
+    order.resize(keys.size());
+    size_t i = 0;
+    for (int32_t n : movable)
+      if (active[n]) order[bucket_offsets[keys[i++]]++] = n;
 
+    std::fill(next_active.begin(), next_active.end(), 0);
     double largest_relative_move = 0;
     for (int32_t n : order) {
       const double scale = smoother.node_scale(n);
       const double moved = smoother.node_visit(n);
+      if (!(moved > 0)) continue;
       if (scale > 0) largest_relative_move = std::max(largest_relative_move, moved / scale);
+      for (int32_t h : node_hexes(topology, n))
+        for (int32_t m : mesh.hexes[h]) next_active[m] = 1;
     }
+    active.swap(next_active);
     ++stats.sweeps;
     double sweep_min, sweep_mean;
     stats_min_mean(smoother.quality(), sweep_min, sweep_mean);

@@ -17,11 +17,12 @@
 
 namespace hexrefine {
 
+/// Both methods keep a move only if no hex around the node gets worse than the node's current
+/// local minimum and the local minimum or the local sum of scaled Jacobians rises (smoothing.cpp).
 enum class SmoothMethod {
-  laplacian,  ///< guarded Laplacian: move to the mean of the edge neighbours if no hex gets worse
-              ///< than the current local minimum
-  optimize,   ///< local optimisation: mean-ratio Newton step, then ascent of the local minimum
-              ///< scaled Jacobian, both guarded like the Laplacian
+  laplacian,  ///< guarded Laplacian: towards the mean of the edge neighbours
+  optimize,   ///< guarded Laplacian candidate, then a mean-ratio Newton step, then ascent of the
+              ///< minimum scaled Jacobian of the hexes around the node
 };
 
 struct SmoothOptions {

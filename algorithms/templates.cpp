@@ -284,6 +284,8 @@ TemplateNodeKey TemplateRefiner::key_at(int32_t hex, const TemplateParam& p) con
 }
 
 bool TemplateRefiner::alias(const TemplateNodeKey& from, const TemplateNodeKey& to) {
+  // Too late if a node was already created under `from`: cells made before would keep it.
+  if (nodes_.count(from)) return false;
   auto [it, inserted] = aliases_.emplace(from, to);
   return inserted || it->second == to;
 }
@@ -300,12 +302,43 @@ int32_t TemplateRefiner::node_of(const TemplateNodeKey& key, const Eigen::Vector
   }
   if (k.kind() == TemplateNodeKey::corner) return static_cast<int32_t>(k.entity & 0xFFFFFFFFFF);
   const auto [it, inserted] = nodes_.emplace(k, static_cast<int32_t>(points_.size()));
-  if (inserted) points_.push_back(x);
+  if (inserted) {
+    points_.push_back(x);
+    created_keys_.push_back(k);
+  }
   return it->second;
 }
 
+TemplateNodeKey TemplateRefiner::key_of_template_node(const TemplateCell& cell, int symmetry,
+                                                      const TemplateNode& tn) const {
+  const CubeSymmetry& s = cube_symmetries()[symmetry];
+  if (tn.adjustment_edge >= 0 && cell.whole && !adjustment_by_position_) {
+    const int32_t h = cell.hex;
+    const int le = s.edge[tn.adjustment_edge];
+    const int32_t e = topology_.hex_edge_ids[h][le];
+    const bool same_direction = mesh_.hexes[h][hex_edges[le][0]] == topology_.edge_nodes[e][0];
+    const bool canonical_same = s.vertex[hex_edges[tn.adjustment_edge][0]] == hex_edges[le][0];
+    return key_adjustment(
+        e, (same_direction == canonical_same) ? tn.adjustment_index : 1 - tn.adjustment_index);
+  }
+  const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
+  std::array<int64_t, 3> p6{};
+  for (int k = 0; k < 3; ++k) {
+    p6[k] = std::lround(6.0 * p[k]);
+    if (std::abs(6.0 * p[k] - double(p6[k])) > 1e-9)
+      throw OperationError("hex " + std::to_string(cell.hex) + ": template node off the grid");
+  }
+  TemplateParam param;
+  if (!cell.exact || !cell_map_sixths(cell, p6, param))
+    throw OperationError("hex " + std::to_string(cell.hex) + ": sub-hex nested too deep");
+  if ((p6[0] % 6 == 0) && (p6[1] % 6 == 0) && (p6[2] % 6 == 0) && tn.adjustment_edge < 0)
+    return cell.key[vertex_of({int(p6[0] / 6), int(p6[1] / 6), int(p6[2] / 6)})];
+  return key_at(cell.hex, param);
+}
+
 void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int symmetry,
-                            std::vector<TemplateCell>& children) {
+                            std::vector<TemplateCell>& children,
+                            std::vector<TemplateNodeKey>* node_keys) {
   const CubeSymmetry& s = cube_symmetries()[symmetry];
   const int32_t h = cell.hex;
   const HexCell& input = mesh_.hexes[h];
@@ -350,7 +383,7 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
     const Eigen::Vector3d position =
         out.exact ? trilinear(x, param_to_ref(out.param)) : trilinear(xc, p);
     if (tn.adjustment_edge >= 0) {
-      if (cell.whole) {
+      if (cell.whole && !adjustment_by_position_) {
         const int le = s.edge[tn.adjustment_edge];
         const int32_t e = topology_.hex_edge_ids[h][le];
         // Adjustment index in the edge's global direction.
@@ -375,12 +408,21 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
       points_.push_back(position);
       out.node = static_cast<int32_t>(points_.size() - 1);
       out.key = make_key(TemplateNodeKey::fresh, out.node);
+      created_keys_.push_back(out.key);
       continue;
     }
     out.key = key_at(h, out.param);
     out.node = node_of(out.key, position, &out.aliased);
   }
 
+  for (size_t i = 0; i < placed.size(); ++i)
+    for (size_t j = i + 1; j < placed.size(); ++j)
+      if (placed[i].node == placed[j].node)
+        fail("two template nodes fall on one node (the cell is degenerate)");
+  if (node_keys) {
+    node_keys->resize(placed.size());
+    for (size_t i = 0; i < placed.size(); ++i) (*node_keys)[i] = placed[i].key;
+  }
   for (const auto& child : t.children) {
     std::array<int16_t, 8> c = child;
     if (s.reflection) c = {c[0], c[3], c[2], c[1], c[4], c[7], c[6], c[5]};

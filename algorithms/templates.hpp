@@ -163,7 +163,8 @@ class TemplateRefiner {
   static TemplateNodeKey key_adjustment(int32_t edge, int k);
 
   /// Nodes named `from` are the node named `to` from now on. Returns false (and changes nothing)
-  /// if `from` already names a different node: two adjustments would collapse one face.
+  /// if `from` already names a different node (two adjustments would collapse one face) or a
+  /// node was already created under `from` (the alias would come too late).
   bool alias(const TemplateNodeKey& from, const TemplateNodeKey& to);
 
   /// Applies `tmpl` in orientation `symmetry` to `cell` and appends its children to `children`
@@ -184,6 +185,12 @@ class TemplateRefiner {
   /// Key of every node created so far, indexed by node id - input point count.
   const std::vector<TemplateNodeKey>& created_keys() const { return created_keys_; }
 
+  /// Key adjustment nodes of whole cells by their exact position inside the hex (like those of
+  /// sub-cells) instead of by (edge, index): needed when the cells around an adjustment are
+  /// refined again, so that a later template naming that position finds the same node. Aliases
+  /// must then target TemplateRefiner::key_at positions (templates_apply keeps (edge, index)).
+  void set_adjustment_keys_by_position(bool on) { adjustment_by_position_ = on; }
+
   /// Output points (input points first, then every node created).
   const std::vector<Eigen::Vector3d>& points() const { return points_; }
   std::vector<Eigen::Vector3d>& points() { return points_; }
@@ -194,6 +201,7 @@ class TemplateRefiner {
   const HexTopology& topology_;
   std::vector<Eigen::Vector3d> points_;
   std::vector<TemplateNodeKey> created_keys_;
+  bool adjustment_by_position_ = false;
   std::unordered_map<TemplateNodeKey, int32_t, TemplateNodeKeyHash> nodes_;
   std::unordered_map<TemplateNodeKey, TemplateNodeKey, TemplateNodeKeyHash> aliases_;
 };

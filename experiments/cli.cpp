@@ -26,8 +26,8 @@ const char* usage_text =
     "         [--allow-inverted] [--report R.json]\n"
     "  smooth IN OUT [--method laplacian|optimize] [--region SPEC ...] [--sweeps N]\n"
     "         [--report R.json]\n"
-    "  run CASES.json [--resume] [--quiet] [--shard K/N]\n"
-    "  reproduce [--quick] [--resume] [--quiet]\n"
+    "  run CASES.json [--resume] [--quiet] [--shard K/N] [--output OUT.jsonl]\n"
+    "  reproduce [--quick] [--resume] [--quiet] [--no-plots]\n"
     "  merge OUT.jsonl IN.jsonl [IN.jsonl ...]\n"
     "exit codes: 0 done, 1 the operation failed, 2 bad usage or bad input\n";
 

@@ -12,6 +12,7 @@
 
 #include "algorithms/selective.hpp"
 #include "algorithms/sheet.hpp"
+#include "algorithms/smoothing.hpp"
 #include "experiments/runner.hpp"
 #include "mesh/error.hpp"
 #include "mesh/topology.hpp"
@@ -21,13 +22,6 @@
 #include "mesh/io.hpp"
 #include "mesh/quality.hpp"
 #include "mesh/selection.hpp"
-
-// Smoothing lands on main from another branch; until it has, a case asking for it records
-// "smooth_error" instead of the smoothed minimum.
-#if __has_include("algorithms/smoothing.hpp")
-#include "algorithms/smoothing.hpp"
-#define HEXREFINE_RUNNER_HAVE_SMOOTHING 1
-#endif
 
 namespace hexrefine {
 
@@ -191,15 +185,17 @@ void case_execute(const RunCase& c, const std::vector<std::string>& methods, con
       fields["mesh_file"] = (std::filesystem::path(c.save_mesh_dir).filename() / name).string();
     }
     if (c.smooth) {
-#ifdef HEXREFINE_RUNNER_HAVE_SMOOTHING
+      // As `refine --smooth`: the refined and transition hexes move, the untouched ones stay.
       HexMesh smoothed = result.mesh;
-      const SmoothStats smooth_stats = mesh_smooth(smoothed, SmoothOptions{});
-      (void)smooth_stats;
-      fields["smoothed_min_scaled_jacobian"] = mesh_min_scaled_jacobian(smoothed);
-#else
-      fields["smoothed_min_scaled_jacobian"] = nullptr;
-      fields["smooth_error"] = "algorithms/smoothing.hpp has not landed in this build";
-#endif
+      SmoothOptions smooth_options;
+      smooth_options.region_hexes = mesh_refined_hexes(smoothed);
+      if (!smooth_options.region_hexes.empty()) {
+        const SmoothStats smooth_stats = mesh_smooth(smoothed, smooth_options);
+        fields["smoothed_min_scaled_jacobian"] = smooth_stats.min_scaled_jacobian_after;
+        fields["smoothing"] = smooth_stats_to_json(smooth_stats);
+      } else {
+        fields["smoothed_min_scaled_jacobian"] = fields["min_scaled_jacobian"];
+      }
     }
     emit(method, std::move(fields));
   }

@@ -5,7 +5,8 @@
 /// 1 (checked against abaqus_hex_2x2x2.inp, whose hexes all have positive volume in this order).
 /// Other 3D continuum elements (names containing "3D": C3D4, C3D6, C3D20R...) are refused;
 /// shells, beams, masses and the like are skipped. Element sets named BLOCK_<integer> give
-/// block_id (case-insensitive); hexes in none get 0. Other keywords are skipped.
+/// block_id (case-insensitive); hexes in none get 0. *INCLUDE is refused; other keywords are
+/// skipped. The format has no counts, so a file cut at a line end reads as a smaller mesh.
 
 #include <algorithm>
 
@@ -109,6 +110,8 @@ HexMesh abaqus_read(const std::string& path) {
       const std::vector<std::string_view> fields = split_commas(line.substr(1));
       const std::string key = upper(fields[0]);
       mode = Mode::skip;
+      if (key == "INCLUDE")
+        fail_line("*INCLUDE is not supported (skipping it would silently drop part of the mesh)");
       if (key == "NODE") {
         mode = Mode::node;
       } else if (key == "ELEMENT") {
@@ -202,6 +205,7 @@ HexMesh abaqus_read(const std::string& path) {
     }
   }
   if (!saw_keyword) in.fail("no Abaqus keyword line (*NODE, *ELEMENT) found");
+  if (items_sort_by_permutation_ids(mesh.points, node_ids)) node_lines.clear();
   IdIndex nodes;
   if (const int64_t bad = nodes.build(node_ids); bad >= 0)
     throw InputError(

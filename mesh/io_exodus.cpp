@@ -2,9 +2,12 @@
 /// Exodus II (.e, .exo) through libexodusii. HEX8 (and HEX/HEXAHEDRON with 8 nodes) has VTK's
 /// node order. Each element block is one block_id; blocks of other 3D elements (TETRA, WEDGE,
 /// PYRAMID, HEX20, HEX27, NFACED) are refused, blocks of shells, quads, triangles, bars and spheres
-/// are skipped. Coordinates are written as doubles (exact round trip). Hexes are written block by
-/// block with the element id map holding each hex's index + 1; the reader orders hexes by id when
-/// the ids of the hexes are a permutation of 1..n, so a written mesh reads back in its own order.
+/// are skipped. Exodus block ids must be positive: a block_id <= 0 is written under a fresh
+/// positive id (above every positive block_id) and the block is named "hexrefine_block_id=<v>";
+/// the reader takes block_id from such a name, else from the Exodus id. Coordinates are written as
+/// doubles (exact round trip). Hexes are written block by block with the element id map holding
+/// each hex's index + 1; the reader orders hexes by id when the ids of the hexes are a permutation
+/// of 1..n, so a written mesh reads back in its own order.
 
 #include <exodusII.h>
 
@@ -129,7 +132,17 @@ HexMesh exodus_read(const std::string& path) {
                        " with " + std::to_string(per) +
                        " nodes: only linear hexahedra (HEX8) are supported");
     if (hex && count > 0) {
-      if (bid < INT32_MIN || bid > INT32_MAX)
+      int64_t block_id = bid;
+      char block_name[257] = {0};  // beyond any name length the library returns
+      if (ex_get_name(file.id, EX_ELEM_BLOCK, bid, block_name) >= 0) {
+        const std::string_view name(block_name);
+        const std::string_view prefix = "hexrefine_block_id=";
+        int64_t v = 0;
+        if (name.substr(0, prefix.size()) == prefix &&
+            TextCursor::parse_integer(name.substr(prefix.size()), v))
+          block_id = v;
+      }
+      if (block_id < INT32_MIN || block_id > INT32_MAX)
         throw InputError(where + ": block id out of the int32 range");
       std::vector<int64_t> conn(count * 8);
       if (ex_get_conn(file.id, EX_ELEM_BLOCK, bid, conn.data(), nullptr, nullptr) < 0)
@@ -144,7 +157,7 @@ HexMesh exodus_read(const std::string& path) {
           c[k] = static_cast<int32_t>(v - 1);
         }
         mesh.hexes.push_back(c);
-        block.push_back(static_cast<int32_t>(bid));
+        block.push_back(static_cast<int32_t>(block_id));
         hex_ids.push_back(element_map[first_element + e]);
       }
     }
@@ -184,6 +197,10 @@ void exodus_write(const std::string& path, const HexMesh& mesh) {
   std::vector<int64_t> blocks;
   for (const auto& [b, h] : order)
     if (blocks.empty() || blocks.back() != b) blocks.push_back(b);
+  // Exodus id of each block: the block_id itself when positive, else a fresh id above them all.
+  std::vector<int64_t> exodus_ids(blocks.size());
+  int64_t next_id = std::max<int64_t>(blocks.empty() ? 0 : blocks.back(), 0) + 1;
+  for (size_t b = 0; b < blocks.size(); ++b) exodus_ids[b] = blocks[b] > 0 ? blocks[b] : next_id++;
 
   const std::string tmp = file_temporary_beside(path);
   auto failed = [&](const std::string& what) {
@@ -208,18 +225,24 @@ void exodus_write(const std::string& path, const HexMesh& mesh) {
     if (ex_put_coord_names(file.id, names) < 0) failed("coordinate names");
     size_t i = 0;
     std::vector<int64_t> map(m);
-    for (int64_t b : blocks) {
+    for (size_t bi = 0; bi < blocks.size(); ++bi) {
+      const int64_t b = blocks[bi], eid = exodus_ids[bi];
       const size_t first = i;
       std::vector<int64_t> conn;
       for (; i < m && order[i].first == b; ++i) {
         for (int32_t v : mesh.hexes[order[i].second]) conn.push_back(v + 1);
         map[i] = order[i].second + 1;
       }
-      if (ex_put_block(file.id, EX_ELEM_BLOCK, b, "HEX8", static_cast<int64_t>(i - first), 8, 0, 0,
-                       0) < 0)
+      if (ex_put_block(file.id, EX_ELEM_BLOCK, eid, "HEX8", static_cast<int64_t>(i - first), 8, 0,
+                       0, 0) < 0)
         failed("element block " + std::to_string(b));
-      if (ex_put_conn(file.id, EX_ELEM_BLOCK, b, conn.data(), nullptr, nullptr) < 0)
+      if (ex_put_conn(file.id, EX_ELEM_BLOCK, eid, conn.data(), nullptr, nullptr) < 0)
         failed("connectivity of element block " + std::to_string(b));
+      if (b <= 0) {
+        const std::string name = "hexrefine_block_id=" + std::to_string(b);
+        if (ex_put_name(file.id, EX_ELEM_BLOCK, eid, name.c_str()) < 0)
+          failed("name of element block " + std::to_string(b));
+      }
     }
     if (m > 0 && ex_put_id_map(file.id, EX_ELEM_MAP, map.data()) < 0) failed("element id map");
     const int id = file.id;

@@ -2,8 +2,9 @@
 /// Gmsh ASCII meshes (.msh): format 4.1 read and write, 2.2 (also 2.0/2.1) read. Gmsh element
 /// type 5 (8-node hexahedron) has VTK's node order (nodes 0-3 at reference z = -1
 /// counter-clockwise, 4-7 above them), so nodes are copied as they are. Binary .msh files are
-/// refused. Hexes are ordered by element tag when the hex tags are a permutation of 1..n (as we
-/// write them: hex index + 1, grouped into one volume entity per block), otherwise by file order.
+/// refused. Nodes and hexes are ordered by tag when their tags are a permutation of 1..n (gmsh
+/// itself may list nodes out of tag order), otherwise by file order. The writer gives hex h the
+/// tag h + 1 and groups hexes into one volume entity per block_id, so the order survives.
 
 #include <algorithm>
 #include <map>
@@ -253,26 +254,16 @@ HexMesh gmsh_read(const std::string& path) {
   }
   if (!have_nodes || !have_elements) in.fail("expected $Nodes and $Elements sections");
 
+  items_sort_by_permutation_ids(g.mesh.points, g.node_tags);
   IdIndex nodes;
   if (const int64_t bad = nodes.build(g.node_tags); bad >= 0)
     in.fail("node tag " + std::to_string(g.node_tags[bad]) + " repeated or not positive");
   if (g.hex_tags.size() > INT32_MAX) in.fail("too many hexes");
   const size_t m = g.hex_tags.size();
   // Order: by tag when the hex tags are exactly 1..m, else file order.
-  std::vector<int32_t> slot(m);
-  bool permutation = true;
-  {
-    std::vector<char> seen(m, 0);
-    for (size_t i = 0; i < m && permutation; ++i) {
-      const int64_t t = g.hex_tags[i];
-      if (t < 1 || t > static_cast<int64_t>(m) || seen[t - 1])
-        permutation = false;
-      else
-        seen[t - 1] = 1;
-    }
-  }
-  for (size_t i = 0; i < m; ++i)
-    slot[i] = permutation ? static_cast<int32_t>(g.hex_tags[i] - 1) : static_cast<int32_t>(i);
+  std::vector<int32_t> slot = id_permutation_slots(g.hex_tags);
+  if (slot.empty())
+    for (size_t i = 0; i < m; ++i) slot.push_back(static_cast<int32_t>(i));
   g.mesh.hexes.resize(m);
   std::vector<int32_t> block(m);
   for (size_t i = 0; i < m; ++i) {

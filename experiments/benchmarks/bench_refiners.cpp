@@ -1,7 +1,9 @@
 /// Google Benchmark of the two refiners on the same inputs: full refinement of n x n x n unit
 /// bricks (thesis Table G-2; n = 10, 25, 50), hexes within a fixed radius of the top front right
 /// vertex of a brick of fixed size (Table G-3; radius 0.5 of a unit brick, n = 10, 25, 50), the
-/// L-shaped case (Table G-1) and the gear's teeth (Table H-1). Wall-clock times
+/// L-shaped case (Table G-1), the gear's teeth (Table H-1) and the left surface of a 4^3 brick
+/// refined three times (Table H-2). `sheet_one_per_pass` runs the sheet refiner in Harris' order
+/// (one sheet per pass) on the smaller bricks. Wall-clock times
 /// (UseRealTime). Counters: final hexes, hexes created and deleted, sheet passes, added targets,
 /// per-phase seconds (of the last iteration), and `s/initial_hex` (seconds per input hex; flat
 /// when the time grows linearly). A refiner that throws (e.g. not implemented yet) is reported
@@ -11,6 +13,7 @@
 ///   --benchmark_out=results/benchmarks/refiners.json --benchmark_out_format=json
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <exception>
 #include <string>
 
@@ -68,11 +71,11 @@ Targets targets_block(const HexMesh& m, int32_t block) {
 }
 
 void run(benchmark::State& state, RefineFunction refine, const HexMesh& mesh,
-         const Targets& targets) {
+         const Targets& targets, const RefineOptions& options = {}) {
   RefineStats last;
   try {
     for (auto _ : state) {
-      RefineResult r = refine(mesh, targets, RefineOptions{});
+      RefineResult r = refine(mesh, targets, options);
       benchmark::DoNotOptimize(r.mesh.hexes.data());
       last = std::move(r.stats);
     }
@@ -114,12 +117,41 @@ void bench_gear_teeth(benchmark::State& state, RefineFunction refine) {
   run(state, refine, mesh, targets_block(mesh, gear_block_teeth));
 }
 
+// Table H-2: 4x4x4 brick, left surface refined three times (passes = 3; the selective refiner
+// with its buffer layer, as in the thesis).
+void bench_left_three_passes(benchmark::State& state, RefineFunction refine) {
+  const HexMesh mesh = unit_brick(4);
+  Targets left;
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j) left.hexes.push_back(brick_hex({4, 4, 4}, 0, j, k));
+  std::sort(left.hexes.begin(), left.hexes.end());
+  RefineOptions options;
+  options.passes = 3;
+  options.buffer = refine == selective;
+  run(state, refine, mesh, left, options);
+}
+
+// Harris' order, one sheet per pass with a copy and topology build of the refined region per
+// pass: what a per-sheet implementation costs (the grouped rounds above do the same passes).
+RefineResult sheet_one_per_pass(const HexMesh& mesh, const Targets& targets,
+                                const RefineOptions& options) {
+  SheetControl control;
+  control.one_sheet_per_round = true;
+  return sheet_refine(mesh, targets, options, control);
+}
+
 void sizes(benchmark::internal::Benchmark* b) {
   b->Arg(10)->Arg(25)->Arg(50)->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 
 BENCHMARK_CAPTURE(bench_full_brick, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, selective, selective)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_full_brick, sheet_one_per_pass, &sheet_one_per_pass)
+    ->Arg(10)
+    ->Arg(20)
+    ->Arg(25)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(bench_radial, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_radial, selective, selective)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_l_shaped, sheet, sheet)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -128,6 +160,13 @@ BENCHMARK_CAPTURE(bench_l_shaped, selective, selective)
     ->UseRealTime();
 BENCHMARK_CAPTURE(bench_gear_teeth, sheet, sheet)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(bench_gear_teeth, selective, selective)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK_CAPTURE(bench_left_three_passes, sheet, sheet)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(bench_left_three_passes, selective, selective)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -63,6 +63,7 @@ TEST(IoAbaqus, RefusesTetsUndefinedNodesAndShortRows) {
       {"*NODE\n1, 0, nan, 0\n", ":2: expected a finite node coordinate"},
       {"*NODE\n1, 0, 0, 0\n1, 1, 0, 0\n", ":3: node id 1 repeated"},
       {"hello\n", "no Abaqus keyword line"},
+      {nodes + "*INCLUDE, INPUT=more.inp\n", ":10: *INCLUDE is not supported"},
   };
   int i = 0;
   for (const auto& [text, expected] : cases) {

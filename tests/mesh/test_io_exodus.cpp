@@ -19,6 +19,18 @@ TEST(IoExodus, RoundTripIsExactAndKeepsBlocksAndOrder) {
   EXPECT_EQ(mesh_find_attribute(r, attribute_template_tag), nullptr);
 }
 
+TEST(IoExodus, NonPositiveBlockIdsSurviveThroughBlockNames) {
+  const auto dir = test_temp_dir("io_exodus_negative");
+  HexMesh m = io_test_brick();
+  mesh_attribute(m, attribute_block_id)[0] = -1;  // EX_INVALID_ID as an Exodus id
+  mesh_attribute(m, attribute_block_id)[4] = 0;
+  const std::string path = (dir / "neg.e").string();
+  mesh_write(path, m);
+  const HexMesh r = mesh_read(path);
+  io_expect_same_geometry(m, r, 0);
+  io_expect_same_attribute(m, r, attribute_block_id);
+}
+
 TEST(IoExodus, MeshWithoutBlocksIsBlockOne) {
   const auto dir = test_temp_dir("io_exodus_noblock");
   const HexMesh m = fixture_brick(2, 1, 1);

@@ -40,6 +40,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "algorithms/templates.hpp"
@@ -122,18 +123,19 @@ std::vector<NewEdge> template_new_edges(const HexTemplate& t) {
   std::vector<NewEdge> out;
   std::vector<std::pair<int16_t, int16_t>> seen;
   auto extreme = [](double x) { return std::abs(x) < 1e-12 || std::abs(x - 1) < 1e-12; };
-  for (const auto& c : t.children) {
+  for (size_t ci = 0; ci < t.children.size(); ++ci) {
+    const auto& c = t.children[ci];
     for (int e = 0; e < 12; ++e) {
       int16_t a = c[hex_edges[e][0]], b = c[hex_edges[e][1]];
       if (a > b) std::swap(a, b);
       if (std::find(seen.begin(), seen.end(), std::make_pair(a, b)) != seen.end()) continue;
       seen.emplace_back(a, b);
+      // The sheet class of this edge (not its geometric direction).
+      const int axis = t.child_axis[ci][hex_edge_axis[e]];
       const auto& ra = t.nodes[a].ref;
       const auto& rb = t.nodes[b].ref;
       int shared = 0, face = -1;
-      int axis = 0;
       for (int k = 0; k < 3; ++k) {
-        if (std::abs(rb[k] - ra[k]) > std::abs(rb[axis] - ra[axis])) axis = k;
         const bool on = t.nodes[a].adjustment_edge < 0 && t.nodes[b].adjustment_edge < 0 &&
                         extreme(ra[k]) && std::abs(ra[k] - rb[k]) < 1e-12;
         if (on) {
@@ -141,7 +143,9 @@ std::vector<NewEdge> template_new_edges(const HexTemplate& t) {
           face = 2 * k + (ra[k] > 0.5 ? 1 : 0);
         }
       }
-      if (shared >= 2 || axis == 0) continue;  // a piece of a cell edge, or parallel to x
+      // A piece of a cell edge, parallel to the refined x, or on a sheet closed inside.
+      if (shared >= 2 || axis <= 0) continue;
+      if (face >= 0 && face / 2 == axis) face = -1;
       out.push_back({a, b, static_cast<int8_t>(axis), static_cast<int8_t>(face)});
     }
   }
@@ -163,6 +167,12 @@ bool template_is_adjusted(const HexTemplate* t) {
   return t == &template_1_3_adjust1() || t == &template_1_3_adjust2();
 }
 
+// Thrown when directional refinement meets an adjustment it can only avoid by splitting an input
+// edge (Appendix F): the pass starts again with that edge split from the outset.
+struct InputEdgeSplitNeeded {
+  int32_t edge;
+};
+
 struct PassOutput {
   HexMesh mesh;
   std::vector<int32_t> parent;
@@ -171,9 +181,15 @@ struct PassOutput {
 
 class SelectivePass {
  public:
+  /// `forced_splits`: input edges split from the outset (found by earlier attempts).
   SelectivePass(const HexMesh& mesh, const std::vector<int32_t>& targets,
-                const RefineOptions& options, RefineStats& stats)
-      : mesh_(mesh), targets_(targets), options_(options), stats_(stats) {}
+                const RefineOptions& options, RefineStats& stats,
+                const std::vector<int32_t>& forced_splits)
+      : mesh_(mesh),
+        targets_(targets),
+        options_(options),
+        stats_(stats),
+        forced_splits_(forced_splits) {}
 
   PassOutput run();
 
@@ -191,7 +207,17 @@ class SelectivePass {
   void rank();
   void refine_directional();
   bool cell_edge_split(const TemplateCell& c, int le) const;
-  void decide(int32_t di, int axis, std::vector<Decision>& out);
+  /// The input edge that local edge `le` of cell `c` lies on, or -1.
+  int32_t cell_edge_input_edge(const TemplateCell& c, int le) const;
+  /// Chooses the templates of hex di's cells in direction `axis`; returns true if it split an
+  /// edge to avoid a doublet (the round must choose again).
+  bool decide(int32_t di, int axis, std::vector<Decision>& out);
+  struct AliasPair {
+    TemplateNodeKey from, to;
+    int8_t edge;  // local edge of the cell at which the adjustment sits
+  };
+  void adjustment_aliases(const TemplateCell& cell, const TemplateChoice& c,
+                          std::vector<AliasPair>& out) const;
   void register_adjustments(const TemplateCell& cell, const TemplateChoice& c);
   void apply(const Decision& d, std::vector<TemplateCell>& next);
   void check_output(const PassOutput& out) const;
@@ -200,6 +226,7 @@ class SelectivePass {
   const std::vector<int32_t>& targets_;
   const RefineOptions& options_;
   RefineStats& stats_;
+  const std::vector<int32_t>& forced_splits_;
   HexTopology topo_;
   std::unique_ptr<TemplateRefiner> refiner_;
   std::vector<uint8_t> split_;  // per input edge
@@ -226,13 +253,20 @@ void SelectivePass::mark() {
   }
   // Hexes around split edges (linear in the region).
   std::vector<uint8_t> seen(nh, 0);
+  auto touch = [&](int32_t e) {
+    for (int32_t n : edge_hexes(topo_, e))
+      if (role_[n] != kTarget && !seen[n]) {
+        seen[n] = 1;
+        touched_.push_back(n);
+      }
+  };
   for (int32_t h : targets_)
-    for (int32_t e : topo_.hex_edge_ids[h])
-      for (int32_t n : edge_hexes(topo_, e))
-        if (role_[n] != kTarget && !seen[n]) {
-          seen[n] = 1;
-          touched_.push_back(n);
-        }
+    for (int32_t e : topo_.hex_edge_ids[h]) touch(e);
+  for (int32_t e : forced_splits_) {
+    if (!split_[e]) ++stats_.doublets_resolved;
+    split_[e] = 1;
+    touch(e);
+  }
   std::sort(touched_.begin(), touched_.end());
 }
 
@@ -263,8 +297,16 @@ void SelectivePass::resolve_doublets() {
         const int le = adj[i];
         const int32_t e = topo_.hex_edge_ids[h][le];
         bool bad = edge_face_count(topo_, e) < 4;
-        for (int lf : hex_edge_faces[le])
+        for (int lf : hex_edge_faces[le]) {
           bad = bad || face_is_boundary(topo_, topo_.hex_face_ids[h][lf]);
+          // A directional neighbour across a merged face would have to refine a cell whose
+          // corners were moved onto the adjustment (not supported): split instead.
+          const int32_t n = hex_face_neighbor(topo_, h, lf);
+          if (n >= 0 && role_[n] != kTarget) {
+            const uint16_t nm = hex_split_mask(topo_, split_, n);
+            bad = bad || (nm && !template_for_mask(nm).tmpl);
+          }
+        }
         if (adjusting_hex[e] >= 0 && adjusting_hex[e] != h) bad = true;
         if (adjusting_hex[e] < 0) {
           adjusting_hex[e] = h;
@@ -311,7 +353,8 @@ void SelectivePass::choose() {
       register_adjustments(refiner_->cell_whole(h), element_choice_[h]);
 }
 
-void SelectivePass::register_adjustments(const TemplateCell& cell, const TemplateChoice& c) {
+void SelectivePass::adjustment_aliases(const TemplateCell& cell, const TemplateChoice& c,
+                                       std::vector<AliasPair>& out) const {
   const CubeSymmetry& s = cube_symmetries()[c.symmetry];
   for (const TemplateNode& tn : c.tmpl->nodes) {
     if (tn.adjustment_edge < 0) continue;
@@ -323,13 +366,20 @@ void SelectivePass::register_adjustments(const TemplateCell& cell, const Templat
     const std::array<std::array<double, 3>, 2> q = {{{tn.ref[0], ye, 0.5}, {tn.ref[0], 0.5, ze}}};
     for (const auto& r : q) {
       TemplateNode qn{r};
-      const TemplateNodeKey from = refiner_->key_of_template_node(cell, c.symmetry, qn);
-      if (!refiner_->alias(from, to))
-        throw OperationError("selective_refine: hex " + std::to_string(cell.hex) +
-                             ": two adjustments would collapse the same face (a doublet)");
+      out.push_back({refiner_->key_of_template_node(cell, c.symmetry, qn), to,
+                     static_cast<int8_t>(s.edge[tn.adjustment_edge])});
     }
-    (void)s;
   }
+}
+
+void SelectivePass::register_adjustments(const TemplateCell& cell, const TemplateChoice& c) {
+  std::vector<AliasPair> pairs;
+  adjustment_aliases(cell, c, pairs);
+  for (const AliasPair& p : pairs)
+    if (!refiner_->alias(p.from, p.to))
+      throw OperationError("selective_refine: hex " + std::to_string(cell.hex) +
+                           ": an adjustment would collapse a face that is already subdivided, or "
+                           "one collapsed by another adjustment (a doublet)");
 }
 
 void SelectivePass::rank() {
@@ -427,6 +477,23 @@ void SelectivePass::rank() {
   }
 }
 
+int32_t SelectivePass::cell_edge_input_edge(const TemplateCell& c, int le) const {
+  const auto& pa = c.param[hex_edges[le][0]];
+  const auto& pb = c.param[hex_edges[le][1]];
+  for (int e = 0; e < 12; ++e) {
+    int fixed = 0;
+    bool match = true;
+    for (int m = 0; m < 3; ++m) {
+      if (m == hex_edge_axis[e]) continue;
+      const int64_t x = hex_corner[hex_edges[e][0]][m] * template_param_unit;
+      match = match && pa[m] == x && pb[m] == x;
+      ++fixed;
+    }
+    if (match && fixed == 2) return topo_.hex_edge_ids[c.hex][e];
+  }
+  return -1;
+}
+
 bool SelectivePass::cell_edge_split(const TemplateCell& c, int le) const {
   const int a = hex_edges[le][0], b = hex_edges[le][1];
   const TemplateNodeKey& ka = c.key[a];
@@ -455,7 +522,7 @@ bool SelectivePass::cell_edge_split(const TemplateCell& c, int le) const {
   return split_segments_.count(segment_key(ka, kb)) > 0;
 }
 
-void SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
+bool SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
   const std::vector<TemplateCell>& cells = cells_[di];
   for (int32_t ci = 0; ci < static_cast<int32_t>(cells.size()); ++ci) {
     const TemplateCell& c = cells[ci];
@@ -505,6 +572,25 @@ void SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
             if (match && edge_face_count(topo_, topo_.hex_edge_ids[c.hex][e]) < 4) bad = true;
           }
         }
+        if (on == 0) {
+          // Inside the input hex: the faces around the edge are those of this hex's cells.
+          const int32_t na = c.nodes[hex_edges[le][0]], nb = c.nodes[hex_edges[le][1]];
+          int valence = 0;
+          for (const TemplateCell& o : cells)
+            for (int e = 0; e < 12; ++e) {
+              const int32_t x = o.nodes[hex_edges[e][0]], y = o.nodes[hex_edges[e][1]];
+              valence += (x == na && y == nb) || (x == nb && y == na);
+            }
+          if (valence < 4) {
+            // Appendix F inside the hex: split the edge and choose this rank's templates again.
+            if (split_segments_
+                    .insert(segment_key(c.key[hex_edges[le][0]], c.key[hex_edges[le][1]]))
+                    .second)
+              ++stats_.doublets_resolved;
+            return true;
+          }
+        }
+        if (bad && on == 2) throw InputEdgeSplitNeeded{cell_edge_input_edge(c, le)};
         if (bad)
           throw OperationError("selective_refine: hex " + std::to_string(c.hex) +
                                ": a directional adjustment would create a doublet");
@@ -512,6 +598,7 @@ void SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
     }
     out.push_back(d);
   }
+  return false;
 }
 
 void SelectivePass::apply(const Decision& d, std::vector<TemplateCell>& next) {
@@ -539,8 +626,52 @@ void SelectivePass::refine_directional() {
   std::vector<TemplateCell> next;
   std::vector<uint8_t> replaced;
   for (const auto& round : rounds_) {
-    decisions.clear();
-    for (const auto& [di, d] : round) decide(di, d, decisions);
+    for (bool again = true; again;) {
+      again = false;
+      decisions.clear();
+      for (const auto& [di, d] : round) again = decide(di, d, decisions) || again;
+      if (again) continue;
+      // Two adjustments collapsing one face (Appendix F, Figure F-3): split the second one's
+      // edge when it lies inside its input hex, and choose again.
+      struct Owner {
+        TemplateNodeKey to;
+        const TemplateCell* cell;
+        int8_t edge;
+      };
+      std::unordered_map<TemplateNodeKey, Owner, TemplateNodeKeyHash> round_alias;
+      std::vector<AliasPair> pairs;
+      // Splits the adjusted edge of `c` if it lies inside its input hex.
+      auto split_inside = [&](const TemplateCell& c, int le) {
+        const int a = hex_edges[le][0], b = hex_edges[le][1];
+        for (int m = 0; m < 3; ++m)
+          if ((c.param[a][m] == 0 || c.param[a][m] == template_param_unit) &&
+              c.param[b][m] == c.param[a][m])
+            return false;
+        if (split_segments_.insert(segment_key(c.key[a], c.key[b])).second)
+          ++stats_.doublets_resolved;
+        return true;
+      };
+      for (const Decision& dc : decisions) {
+        if (!template_is_adjusted(dc.choice.tmpl)) continue;
+        const TemplateCell& c = cells_[dc.di][dc.cell];
+        pairs.clear();
+        adjustment_aliases(c, dc.choice, pairs);
+        for (const AliasPair& p : pairs) {
+          const auto [it, inserted] = round_alias.emplace(p.from, Owner{p.to, &c, p.edge});
+          if (inserted || it->second.to == p.to) continue;
+          if (!split_inside(c, p.edge) && !split_inside(*it->second.cell, it->second.edge)) {
+            for (const auto& [cc, ee] :
+                 {std::pair{&c, p.edge}, {it->second.cell, it->second.edge}}) {
+              const int32_t ie = cell_edge_input_edge(*cc, ee);
+              if (ie >= 0) throw InputEdgeSplitNeeded{ie};
+            }
+            throw OperationError("selective_refine: hex " + std::to_string(c.hex) +
+                                 ": two directional adjustments collapse one face (a doublet)");
+          }
+          again = true;
+        }
+      }
+    }
     for (const Decision& dc : decisions) {
       if (template_is_adjusted(dc.choice.tmpl))
         register_adjustments(cells_[dc.di][dc.cell], dc.choice);
@@ -620,6 +751,7 @@ PassOutput SelectivePass::run() {
   auto t0 = Clock::now();
   topo_ = topology_build(mesh_);
   refiner_ = std::make_unique<TemplateRefiner>(mesh_, topo_);
+  refiner_->set_adjustment_keys_by_position(true);
   mark();
   resolve_doublets();
   stats_.phase_seconds["marking"] += seconds_since(t0);
@@ -742,8 +874,26 @@ RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
   std::vector<int32_t> current_targets = targets.hexes;
   HexMesh current = mesh;
   for (int pass = 0; pass < options.passes; ++pass) {
-    SelectivePass p(current, current_targets, options, stats);
-    PassOutput out = p.run();
+    // A pass that meets an adjustment it can only avoid by splitting an input edge starts
+    // again with that edge split (each attempt splits one more edge, so this ends).
+    std::vector<int32_t> forced;
+    PassOutput out;
+    const RefineStats before = stats;
+    for (;;) {
+      try {
+        SelectivePass p(current, current_targets, options, stats, forced);
+        out = p.run();
+        break;
+      } catch (const InputEdgeSplitNeeded& need) {
+        if (need.edge < 0 || std::find(forced.begin(), forced.end(), need.edge) != forced.end())
+          throw OperationError("selective_refine: cannot avoid a doublet at input edge " +
+                               std::to_string(need.edge));
+        forced.push_back(need.edge);
+        const auto phases = stats.phase_seconds;
+        stats = before;
+        stats.phase_seconds = phases;
+      }
+    }
     std::vector<int32_t> next;
     for (int32_t h = 0; h < out.mesh.hex_count(); ++h) {
       const uint8_t r = out.role[out.parent[h]];

@@ -146,7 +146,10 @@ class TemplateBuilder {
     child({a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]});
   }
 
-  HexTemplate take() { return std::move(t_); }
+  HexTemplate take() {
+    template_compute_child_axes(t_);
+    return std::move(t_);
+  }
 
  private:
   HexTemplate t_;
@@ -284,6 +287,8 @@ TemplateNodeKey TemplateRefiner::key_at(int32_t hex, const TemplateParam& p) con
 }
 
 bool TemplateRefiner::alias(const TemplateNodeKey& from, const TemplateNodeKey& to) {
+  // Too late if a node was already created under `from`: cells made before would keep it.
+  if (nodes_.count(from)) return false;
   auto [it, inserted] = aliases_.emplace(from, to);
   return inserted || it->second == to;
 }
@@ -300,12 +305,43 @@ int32_t TemplateRefiner::node_of(const TemplateNodeKey& key, const Eigen::Vector
   }
   if (k.kind() == TemplateNodeKey::corner) return static_cast<int32_t>(k.entity & 0xFFFFFFFFFF);
   const auto [it, inserted] = nodes_.emplace(k, static_cast<int32_t>(points_.size()));
-  if (inserted) points_.push_back(x);
+  if (inserted) {
+    points_.push_back(x);
+    created_keys_.push_back(k);
+  }
   return it->second;
 }
 
+TemplateNodeKey TemplateRefiner::key_of_template_node(const TemplateCell& cell, int symmetry,
+                                                      const TemplateNode& tn) const {
+  const CubeSymmetry& s = cube_symmetries()[symmetry];
+  if (tn.adjustment_edge >= 0 && cell.whole && !adjustment_by_position_) {
+    const int32_t h = cell.hex;
+    const int le = s.edge[tn.adjustment_edge];
+    const int32_t e = topology_.hex_edge_ids[h][le];
+    const bool same_direction = mesh_.hexes[h][hex_edges[le][0]] == topology_.edge_nodes[e][0];
+    const bool canonical_same = s.vertex[hex_edges[tn.adjustment_edge][0]] == hex_edges[le][0];
+    return key_adjustment(
+        e, (same_direction == canonical_same) ? tn.adjustment_index : 1 - tn.adjustment_index);
+  }
+  const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
+  std::array<int64_t, 3> p6{};
+  for (int k = 0; k < 3; ++k) {
+    p6[k] = std::lround(6.0 * p[k]);
+    if (std::abs(6.0 * p[k] - double(p6[k])) > 1e-9)
+      throw OperationError("hex " + std::to_string(cell.hex) + ": template node off the grid");
+  }
+  TemplateParam param;
+  if (!cell.exact || !cell_map_sixths(cell, p6, param))
+    throw OperationError("hex " + std::to_string(cell.hex) + ": sub-hex nested too deep");
+  if ((p6[0] % 6 == 0) && (p6[1] % 6 == 0) && (p6[2] % 6 == 0) && tn.adjustment_edge < 0)
+    return cell.key[vertex_of({int(p6[0] / 6), int(p6[1] / 6), int(p6[2] / 6)})];
+  return key_at(cell.hex, param);
+}
+
 void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int symmetry,
-                            std::vector<TemplateCell>& children) {
+                            std::vector<TemplateCell>& children,
+                            std::vector<TemplateNodeKey>* node_keys) {
   const CubeSymmetry& s = cube_symmetries()[symmetry];
   const int32_t h = cell.hex;
   const HexCell& input = mesh_.hexes[h];
@@ -350,7 +386,7 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
     const Eigen::Vector3d position =
         out.exact ? trilinear(x, param_to_ref(out.param)) : trilinear(xc, p);
     if (tn.adjustment_edge >= 0) {
-      if (cell.whole) {
+      if (cell.whole && !adjustment_by_position_) {
         const int le = s.edge[tn.adjustment_edge];
         const int32_t e = topology_.hex_edge_ids[h][le];
         // Adjustment index in the edge's global direction.
@@ -375,12 +411,21 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
       points_.push_back(position);
       out.node = static_cast<int32_t>(points_.size() - 1);
       out.key = make_key(TemplateNodeKey::fresh, out.node);
+      created_keys_.push_back(out.key);
       continue;
     }
     out.key = key_at(h, out.param);
     out.node = node_of(out.key, position, &out.aliased);
   }
 
+  for (size_t i = 0; i < placed.size(); ++i)
+    for (size_t j = i + 1; j < placed.size(); ++j)
+      if (placed[i].node == placed[j].node)
+        fail("two template nodes fall on one node (the cell is degenerate)");
+  if (node_keys) {
+    node_keys->resize(placed.size());
+    for (size_t i = 0; i < placed.size(); ++i) (*node_keys)[i] = placed[i].key;
+  }
   for (const auto& child : t.children) {
     std::array<int16_t, 8> c = child;
     if (s.reflection) c = {c[0], c[3], c[2], c[1], c[4], c[7], c[6], c[5]};
@@ -396,19 +441,18 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
       out.exact = out.exact && pl.exact;
       out.collapsed = out.collapsed || pl.aliased;
     }
-    // Local axes of the child in the cell's frame (sum of its four parallel edges), then in the
-    // input hex's frame.
+    // Local axes of the child: the template's sheet classes (canonical axes), mapped by the
+    // symmetry to the cell's axes, then to the input hex's. A reflection swaps the child's
+    // local x and y (the re-ordering above).
+    const size_t ci = static_cast<size_t>(&child - t.children.data());
     for (int k = 0; k < 3; ++k) {
-      std::array<double, 3> d = {0, 0, 0};
-      for (int e : hex_axis_edges[k]) {
-        const auto pa = cube_symmetry_apply(s, t.nodes[c[hex_edges[e][0]]].ref);
-        const auto pb = cube_symmetry_apply(s, t.nodes[c[hex_edges[e][1]]].ref);
-        for (int m = 0; m < 3; ++m) d[m] += pb[m] - pa[m];
-      }
-      int best = 0;
-      for (int m = 1; m < 3; ++m)
-        if (std::abs(d[m]) > std::abs(d[best])) best = m;
-      out.axis[k] = cell.axis[best];
+      const int kt = s.reflection ? (k == 0 ? 1 : k == 1 ? 0 : 2) : k;
+      const int cls = t.child_axis.empty() ? -1 : t.child_axis[ci][kt];
+      int8_t mapped = -1;
+      if (cls >= 0)
+        for (int m = 0; m < 3; ++m)
+          if (s.axis[m] == cls) mapped = cell.axis[m];
+      out.axis[k] = mapped;
     }
     children.push_back(out);
   }
@@ -479,6 +523,66 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
   return out;
 }
 
+void template_compute_child_axes(HexTemplate& t) {
+  const int nc = static_cast<int>(t.children.size());
+  std::vector<int> parent(3 * nc);
+  for (int i = 0; i < 3 * nc; ++i) parent[i] = i;
+  auto find = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  auto local_edge = [&](int c, int16_t a, int16_t b) {
+    for (int e = 0; e < 12; ++e) {
+      const int16_t x = t.children[c][hex_edges[e][0]], y = t.children[c][hex_edges[e][1]];
+      if ((x == a && y == b) || (x == b && y == a)) return e;
+    }
+    return -1;
+  };
+  // Children sharing a face: each edge of the face joins the two children's directions.
+  std::vector<std::pair<std::array<int16_t, 4>, std::pair<int, int>>> faces;
+  for (int c = 0; c < nc; ++c)
+    for (int f = 0; f < 6; ++f) {
+      std::array<int16_t, 4> q;
+      for (int i = 0; i < 4; ++i) q[i] = t.children[c][hex_faces[f][i]];
+      std::sort(q.begin(), q.end());
+      faces.push_back({q, {c, f}});
+    }
+  std::sort(faces.begin(), faces.end());
+  for (size_t i = 0; i + 1 < faces.size(); ++i) {
+    if (faces[i].first != faces[i + 1].first) continue;
+    const int ca = faces[i].second.first, fa = faces[i].second.second;
+    const int cb = faces[i + 1].second.first;
+    for (int k = 0; k < 4; ++k) {
+      const int le = hex_face_edges[fa][k];
+      const int16_t a = t.children[ca][hex_edges[le][0]], b = t.children[ca][hex_edges[le][1]];
+      const int lb = local_edge(cb, a, b);
+      if (lb < 0) continue;
+      parent[find(3 * ca + hex_edge_axis[le])] = find(3 * cb + hex_edge_axis[lb]);
+    }
+  }
+  // Seeds: a child edge on a cube edge belongs to that edge's axis.
+  std::vector<int8_t> root_class(3 * nc, -1);
+  for (int c = 0; c < nc; ++c)
+    for (int e = 0; e < 12; ++e) {
+      const TemplateNode& na = t.nodes[t.children[c][hex_edges[e][0]]];
+      const TemplateNode& nb = t.nodes[t.children[c][hex_edges[e][1]]];
+      if (na.adjustment_edge >= 0 || nb.adjustment_edge >= 0) continue;
+      int fixed = 0, free_axis = -1;
+      for (int k = 0; k < 3; ++k) {
+        if (is_extreme(na.ref[k]) && std::abs(na.ref[k] - nb.ref[k]) < 1e-12)
+          ++fixed;
+        else
+          free_axis = k;
+      }
+      if (fixed != 2) continue;
+      int8_t& rc = root_class[find(3 * c + hex_edge_axis[e])];
+      if (rc < 0) rc = static_cast<int8_t>(free_axis);
+    }
+  t.child_axis.assign(nc, {-1, -1, -1});
+  for (int c = 0; c < nc; ++c)
+    for (int k = 0; k < 3; ++k) t.child_axis[c][k] = root_class[find(3 * c + k)];
+}
+
 const HexTemplate& template_1_27() {
   static const HexTemplate t = [] {
     HexTemplate r;
@@ -493,6 +597,7 @@ const HexTemplate& template_1_27() {
           r.children.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
                                 id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
                                 id(i, j + 1, k + 1)});
+    template_compute_child_axes(r);
     return r;
   }();
   return t;
@@ -510,6 +615,7 @@ const HexTemplate& template_1_3() {
     for (int i = 0; i < 3; ++i)
       r.children.push_back({id(i, 0, 0), id(i + 1, 0, 0), id(i + 1, 1, 0), id(i, 1, 0), id(i, 0, 1),
                             id(i + 1, 0, 1), id(i + 1, 1, 1), id(i, 1, 1)});
+    template_compute_child_axes(r);
     return r;
   }();
   return t;

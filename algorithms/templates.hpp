@@ -49,7 +49,17 @@ struct HexTemplate {
   TemplateTag tag = TemplateTag::untouched;
   std::vector<TemplateNode> nodes;
   std::vector<std::array<int16_t, 8>> children;
+  /// Per child and local axis: the canonical axis of the parent's sheet that this direction of
+  /// the child belongs to (sheets followed through the children's shared faces, seeded by the
+  /// pieces of the cube's edges), -1 for a sheet closed inside the template. Topological, not
+  /// geometric: in 1-4 the top child's "y" edges (Q1 D, Q2 C) lie on the sheet that turns
+  /// round from the split x-edge, so that direction belongs to x. Filled by
+  /// template_compute_child_axes.
+  std::vector<std::array<int8_t, 3>> child_axis;
 };
+
+/// Fills tmpl.child_axis.
+void template_compute_child_axes(HexTemplate& tmpl);
 
 /// One of the 48 symmetries of the cube: reference point p maps to
 /// q[k] = flip[k] ? 1 - p[axis[k]] : p[axis[k]].
@@ -135,7 +145,8 @@ struct TemplateCell {
   HexCell nodes{};
   std::array<TemplateParam, 8> param{};
   std::array<TemplateNodeKey, 8> key{};
-  /// Local axis k of this cell runs along axis axis[k] of the input hex.
+  /// Local axis k of this cell belongs to the sheet of axis axis[k] of the input hex (-1: a sheet
+  /// closed inside a template, never refined again).
   std::array<int8_t, 3> axis = {0, 1, 2};
   bool whole = true;       ///< the input hex itself
   bool exact = true;       ///< every corner's param is exact (else it cannot be refined further)
@@ -163,7 +174,8 @@ class TemplateRefiner {
   static TemplateNodeKey key_adjustment(int32_t edge, int k);
 
   /// Nodes named `from` are the node named `to` from now on. Returns false (and changes nothing)
-  /// if `from` already names a different node: two adjustments would collapse one face.
+  /// if `from` already names a different node (two adjustments would collapse one face) or a
+  /// node was already created under `from` (the alias would come too late).
   bool alias(const TemplateNodeKey& from, const TemplateNodeKey& to);
 
   /// Applies `tmpl` in orientation `symmetry` to `cell` and appends its children to `children`
@@ -184,6 +196,12 @@ class TemplateRefiner {
   /// Key of every node created so far, indexed by node id - input point count.
   const std::vector<TemplateNodeKey>& created_keys() const { return created_keys_; }
 
+  /// Key adjustment nodes of whole cells by their exact position inside the hex (like those of
+  /// sub-cells) instead of by (edge, index): needed when the cells around an adjustment are
+  /// refined again, so that a later template naming that position finds the same node. Aliases
+  /// must then target TemplateRefiner::key_at positions (templates_apply keeps (edge, index)).
+  void set_adjustment_keys_by_position(bool on) { adjustment_by_position_ = on; }
+
   /// Output points (input points first, then every node created).
   const std::vector<Eigen::Vector3d>& points() const { return points_; }
   std::vector<Eigen::Vector3d>& points() { return points_; }
@@ -194,6 +212,7 @@ class TemplateRefiner {
   const HexTopology& topology_;
   std::vector<Eigen::Vector3d> points_;
   std::vector<TemplateNodeKey> created_keys_;
+  bool adjustment_by_position_ = false;
   std::unordered_map<TemplateNodeKey, int32_t, TemplateNodeKeyHash> nodes_;
   std::unordered_map<TemplateNodeKey, TemplateNodeKey, TemplateNodeKeyHash> aliases_;
 };

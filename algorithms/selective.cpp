@@ -58,6 +58,21 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+// Corner-Jacobian inversion test of an input hex.
+bool hex_is_inverted(const HexMesh& m, int32_t h) {
+  const auto x = hex_points(m, h);
+  for (int v = 0; v < 8; ++v) {
+    std::array<Eigen::Vector3d, 3> e;
+    for (int k = 0; k < 3; ++k) {
+      const int edge = hex_vertex_edges[v][k];
+      const int w = hex_edges[edge][0] == v ? hex_edges[edge][1] : hex_edges[edge][0];
+      e[k] = hex_corner[v][k] ? (x[v] - x[w]) : (x[w] - x[v]);
+    }
+    if (!(e[0].dot(e[1].cross(e[2])) > 0)) return true;
+  }
+  return false;
+}
+
 enum Role : uint8_t { kUntouched = 0, kTarget = 1, kElement = 2, kDirectional = 3 };
 
 // Local edges an element-by-element template or a directional step would adjust at, for a hex
@@ -703,25 +718,62 @@ void SelectivePass::check_output(const PassOutput& out) const {
   std::vector<int32_t> bad_parents;
   for (int32_t f : t.nonmanifold_faces) bad_parents.push_back(out.parent[t.face_hexes[f][0]]);
   const int32_t n_in = mesh_.point_count();
-  std::vector<uint8_t> on_boundary(out.mesh.point_count(), 0);
-  for (int32_t f : topology_boundary_faces(topo_))
-    for (int32_t n : topo_.face_nodes[f]) on_boundary[n] = 1;
+  // A boundary face of the output must lie on one boundary face of the input: every node is
+  // an input node of that face, a node keyed on one of its edges, or a node keyed on it.
   const auto& keys = refiner_->created_keys();
-  for (size_t i = 0; i < keys.size(); ++i) {
-    const TemplateNodeKey& k = keys[i];
-    const int64_t id = k.entity & 0xFFFFFFFFFF;
-    if (k.kind() == TemplateNodeKey::edge)
-      on_boundary[n_in + i] = edge_is_boundary(topo_, static_cast<int32_t>(id));
-    else if (k.kind() == TemplateNodeKey::face)
-      on_boundary[n_in + i] = face_is_boundary(topo_, static_cast<int32_t>(id));
-  }
+  auto key_of = [&](int32_t n) -> const TemplateNodeKey* {
+    return n >= n_in ? &keys[n - n_in] : nullptr;
+  };
+  auto node_on_face = [&](int32_t n, int32_t f) {
+    const auto& fn = topo_.face_nodes[f];
+    auto has = [&](int32_t x) { return std::find(fn.begin(), fn.end(), x) != fn.end(); };
+    const TemplateNodeKey* k = key_of(n);
+    if (!k) return has(n);
+    const int32_t id = static_cast<int32_t>(k->entity & 0xFFFFFFFFFF);
+    if (k->kind() == TemplateNodeKey::face) return id == f;
+    if (k->kind() == TemplateNodeKey::edge)
+      return has(topo_.edge_nodes[id][0]) && has(topo_.edge_nodes[id][1]);
+    return false;
+  };
+  std::vector<int32_t> candidates;
   for (int32_t f : topology_boundary_faces(t)) {
-    bool ok = true;
-    for (int32_t n : t.face_nodes[f]) ok = ok && on_boundary[n];
+    const auto& q = t.face_nodes[f];
+    candidates.clear();
+    int32_t anchor = q[0];
+    for (int32_t n : q) {
+      const TemplateNodeKey* k = key_of(n);
+      if (k && k->kind() == TemplateNodeKey::face) anchor = n;
+    }
+    const TemplateNodeKey* k = key_of(anchor);
+    if (k && k->kind() == TemplateNodeKey::face) {
+      candidates.push_back(static_cast<int32_t>(k->entity & 0xFFFFFFFFFF));
+    } else {
+      // Boundary faces of the input hexes around an input node of this face, or around the
+      // edge a keyed node sits on.
+      int32_t around = -1;
+      for (int32_t n : q)
+        if (n < n_in) around = n;
+      if (around < 0 && k && k->kind() == TemplateNodeKey::edge)
+        around = topo_.edge_nodes[k->entity & 0xFFFFFFFFFF][0];
+      if (around >= 0)
+        for (int32_t h : node_hexes(topo_, around))
+          for (int32_t g : topo_.hex_face_ids[h])
+            if (face_is_boundary(topo_, g)) candidates.push_back(g);
+    }
+    bool ok = false;
+    for (int32_t g : candidates) {
+      bool all = face_is_boundary(topo_, g);
+      for (int32_t n : q) all = all && node_on_face(n, g);
+      if (all) {
+        ok = true;
+        break;
+      }
+    }
     if (!ok) bad_parents.push_back(out.parent[t.face_hexes[f][0]]);
   }
   for (int32_t h = 0; h < out.mesh.hex_count(); ++h) {
     if (out.role[out.parent[h]] == kUntouched) continue;
+    if (options_.allow_inverted && hex_is_inverted(mesh_, out.parent[h])) continue;
     const auto x = hex_points(out.mesh, h);
     for (int v = 0; v < 8; ++v) {
       const Eigen::Vector3d a = x[hex_edges[hex_vertex_edges[v][0]][hex_corner[v][0] ? 0 : 1]];
@@ -830,21 +882,6 @@ PassOutput SelectivePass::run() {
 
   if (options_.ranking && options_.propagation && !options_.ebe_only) check_output(out);
   return out;
-}
-
-// Corner-Jacobian inversion test of an input hex.
-bool hex_is_inverted(const HexMesh& m, int32_t h) {
-  const auto x = hex_points(m, h);
-  for (int v = 0; v < 8; ++v) {
-    std::array<Eigen::Vector3d, 3> e;
-    for (int k = 0; k < 3; ++k) {
-      const int edge = hex_vertex_edges[v][k];
-      const int w = hex_edges[edge][0] == v ? hex_edges[edge][1] : hex_edges[edge][0];
-      e[k] = hex_corner[v][k] ? (x[v] - x[w]) : (x[w] - x[v]);
-    }
-    if (!(e[0].dot(e[1].cross(e[2])) > 0)) return true;
-  }
-  return false;
 }
 
 }  // namespace

@@ -8,10 +8,14 @@
 #include <map>
 #include <random>
 
+#include "algorithms/templates.hpp"
 #include "mesh/conformity.hpp"
+#include "mesh/dual.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"
+#include "mesh/io.hpp"
 #include "tests/algorithms/refiner_suite.hpp"
+#include "tests/cli_runner.hpp"
 #include "tests/fixtures.hpp"
 
 namespace hexrefine {
@@ -158,6 +162,188 @@ TEST(SelectiveRandom, TargetSetsOnJitteredBricks) {
   }
   std::printf("refined %d refused %d empty %d\n", refined, refused, empty);
   for (const auto& [k, v] : refusals) std::printf("  %d x %s\n", v, k.c_str());
+}
+
+}  // namespace
+}  // namespace hexrefine
+
+namespace hexrefine {
+namespace {
+
+// Refines and checks with both the project's checker (against the input) and the suite's
+// topological check; returns the checker's report.
+MeshCheckReport refine_and_check(const HexMesh& m, const std::vector<int32_t>& targets,
+                                 RefineResult* out = nullptr, const RefineOptions& o = {}) {
+  RefineResult r = selective_refine(m, {targets}, o);
+  const MeshCheckReport c = mesh_check(r.mesh, &m);
+  if (out) *out = std::move(r);
+  return c;
+}
+
+std::vector<int32_t> hexes_within(const HexMesh& m, const Eigen::Vector3d& c, double radius) {
+  std::vector<int32_t> t;
+  for (int32_t h = 0; h < m.hex_count(); ++h)
+    if ((hex_centroid(m, h) - c).norm() <= radius) t.push_back(h);
+  return t;
+}
+
+TEST(SelectiveCases, RadialRegionsAtACornerForIntervalsFiveToThirty) {
+  // Table G-3: unit brick, hexes within 0.5 of the corner (1, 1, 1), interval n.
+  for (int n : {5, 10, 15, 20, 25, 30}) {
+    BrickParams bp;
+    bp.dims = {n, n, n};
+    const HexMesh m = generate_brick(bp);
+    const std::vector<int32_t> t = hexes_within(m, {1, 1, 1}, 0.5);
+    RefineResult r;
+    const MeshCheckReport c = refine_and_check(m, t, &r);
+    EXPECT_TRUE(c.valid()) << "interval " << n;
+    EXPECT_EQ(c.doublets, 0);
+    if (n >= 10) {
+      EXPECT_GT(r.stats.directional_hexes, 0) << "interval " << n;
+    }
+    // Targets, and the hexes whose twelve edges all got split by their neighbours.
+    EXPECT_GE(r.stats.hexes_per_template.at("1-27"), 27 * static_cast<int64_t>(t.size()));
+  }
+}
+
+TEST(SelectiveCases, GearTeethCylinderAndTwistedRing) {
+  {
+    const HexMesh gear = generate_gear({});
+    std::vector<int32_t> teeth;
+    const auto* block = mesh_find_attribute(gear, attribute_block_id);
+    ASSERT_NE(block, nullptr);
+    for (int32_t h = 0; h < gear.hex_count(); ++h)
+      if ((*block)[h] == 2) teeth.push_back(h);
+    const MeshCheckReport c = refine_and_check(gear, teeth);
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(c.doublets, 0);
+  }
+  {
+    const HexMesh cyl = generate_cylinder({});
+    const MeshCheckReport c = refine_and_check(cyl, hexes_within(cyl, {0, 0, 0.5}, 0.5));
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(c.doublets, 0);
+  }
+  {
+    // Targets: the hexes of the ring's self-intersecting sheet (section 3 x 3: the middle one).
+    TwistedRingParams rp;
+    rp.section_intervals = 3;
+    const HexMesh ring = generate_twisted_ring(rp);
+    const HexTopology topo = topology_build(ring);
+    const DualSheets d = dual_build(ring, topo);
+    int32_t sheet = -1;
+    for (int32_t s = 0; s < d.sheet_count(); ++s)
+      if (d.sheets[s].self_intersecting) sheet = s;
+    ASSERT_GE(sheet, 0);
+    const auto hexes = sheet_hexes(d, sheet);
+    const MeshCheckReport c =
+        refine_and_check(ring, std::vector<int32_t>(hexes.begin(), hexes.end()));
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(c.doublets, 0);
+  }
+}
+
+TEST(SelectiveCases, SphereRegionsInsideRealMeshes) {
+  // Real meshes with warped boundary quads: the checker's centroid test reports the trapezoid
+  // sub-faces of 1-4 face templates on warped boundary faces as non-conformal (their corner
+  // average is off the bilinear patch); the topology is conformal: no hanging node, no gap
+  // (the suite's check: every output boundary face lies on the input's boundary), no inverted
+  // hex, no doublet.
+  struct Case {
+    std::string file;
+    Eigen::Vector3d centre;
+    double radius;
+  };
+  for (const Case& k :
+       {Case{"ellipsoid.mesh", {0, 0, 0}, 0.1}, Case{"ellipsoid.mesh", {0, 0, 0}, 0.25},
+        Case{"rockerarm.mesh", {0, 0, 0}, 8}}) {
+    const HexMesh m = mesh_read(shared_mesh(k.file));
+    const std::vector<int32_t> t = hexes_within(m, k.centre, k.radius);
+    ASSERT_FALSE(t.empty());
+    RefineResult r;
+    const MeshCheckReport c = refine_and_check(m, t, &r);
+    EXPECT_EQ(c.inverted_hexes, 0) << k.file;
+    EXPECT_EQ(c.doublets, 0) << k.file;
+    EXPECT_EQ(c.hanging_nodes, 0) << k.file;
+    EXPECT_EQ(c.nonmanifold_faces, 0) << k.file;
+    EXPECT_EQ(c.nonmanifold_boundary_edges, 0) << k.file;
+    EXPECT_LT(c.volume_relative_error, 1e-6) << k.file;
+    const HexMesh& out = r.mesh;
+    const HexTopology ot = topology_build(out);
+    EXPECT_TRUE(ot.nonmanifold_faces.empty());
+  }
+}
+
+// A brick whose hexes list their nodes in a random rotation each: same geometry, local axes no
+// longer aligned from hex to hex (as in an unstructured mesh).
+HexMesh brick_with_rotated_hexes(int n, uint64_t seed) {
+  BrickParams bp;
+  bp.dims = {n, n, n};
+  HexMesh m = generate_brick(bp);
+  std::mt19937_64 rng(seed);
+  std::vector<int> proper;
+  for (int s = 0; s < 48; ++s)
+    if (!cube_symmetries()[s].reflection) proper.push_back(s);
+  for (HexCell& c : m.hexes) {
+    const CubeSymmetry& s = cube_symmetries()[proper[rng() % proper.size()]];
+    HexCell r{};
+    for (int v = 0; v < 8; ++v) r[v] = c[s.vertex[v]];
+    c = r;
+  }
+  return m;
+}
+
+TEST(SelectiveAblation, NoRankingBreaksConformityOnTheRadialCase) {
+  const HexMesh m = brick_with_rotated_hexes(10, 3);
+  const std::vector<int32_t> t = hexes_within(m, {1, 1, 1}, 0.5);
+  const MeshCheckReport ranked = refine_and_check(m, t);
+  EXPECT_TRUE(ranked.valid());
+  RefineOptions o;
+  o.ranking = false;
+  const MeshCheckReport unranked = refine_and_check(m, t, nullptr, o);
+  EXPECT_FALSE(unranked.conformal);
+  EXPECT_GT(unranked.non_conformal_faces, 0);
+  std::printf("no-ranking: %ld non-conformal faces, %ld hanging nodes\n",
+              long(unranked.non_conformal_faces), long(unranked.hanging_nodes));
+  o = {};
+  o.propagation = false;
+  EXPECT_GT(refine_and_check(m, t, nullptr, o).non_conformal_faces, 0);
+  o = {};
+  o.ebe_only = true;
+  RefineResult ebe;
+  EXPECT_GT(refine_and_check(m, t, &ebe, o).non_conformal_faces, 0);
+  EXPECT_EQ(ebe.stats.hexes_per_template.count("directional"), 0u);
+}
+
+TEST(SelectivePasses, RegionRefinedTwiceWithAndWithoutBuffer) {
+  const HexMesh m = fixture_brick(4, 4, 4);
+  std::vector<int32_t> left;
+  for (int32_t h = 0; h < m.hex_count(); ++h)
+    if (h % 4 == 0) left.push_back(h);
+  RefineOptions o;
+  o.passes = 2;
+  RefineResult plain;
+  EXPECT_TRUE(refine_and_check(m, left, &plain, o).valid());
+  // Pass 2 targets the 16 x 27 children of the targets: 432 x 27 of them after two passes.
+  EXPECT_EQ(plain.stats.hexes_per_template.at("1-27"), 16 * 27 * 27);
+  o.buffer = true;
+  RefineResult buffered;
+  EXPECT_TRUE(refine_and_check(m, left, &buffered, o).valid());
+  EXPECT_GT(buffered.stats.added_targets, 0);
+  EXPECT_GT(buffered.mesh.hex_count(), plain.mesh.hex_count());
+}
+
+TEST(Selective, RefusesInvertedInputAndBadTargets) {
+  HexMesh m = fixture_brick(2, 1, 1);
+  std::swap(m.hexes[1][0], m.hexes[1][1]);
+  std::swap(m.hexes[1][4], m.hexes[1][5]);
+  std::swap(m.hexes[1][3], m.hexes[1][2]);
+  std::swap(m.hexes[1][7], m.hexes[1][6]);
+  EXPECT_THROW(selective_refine(m, {{0}}, {}), InputError);
+  RefineOptions o;
+  o.allow_inverted = true;
+  EXPECT_NO_THROW(selective_refine(m, {{0}}, o));
+  EXPECT_THROW(selective_refine(fixture_brick(1, 1, 1), {{5}}, {}), InputError);
 }
 
 }  // namespace

@@ -715,7 +715,7 @@ void SelectivePass::check_output(const PassOutput& out) const {
   // open by non-matching subdivisions shows up as a boundary face inside the mesh), and no
   // output hex from a valid input hex is inverted (corner Jacobians).
   const HexTopology t = topology_build(out.mesh);
-  std::vector<int32_t> bad_parents;
+  std::vector<int32_t> bad_parents, inverted_parents;
   for (int32_t f : t.nonmanifold_faces) bad_parents.push_back(out.parent[t.face_hexes[f][0]]);
   const int32_t n_in = mesh_.point_count();
   // A boundary face of the output must lie on one boundary face of the input: every node is
@@ -783,20 +783,27 @@ void SelectivePass::check_output(const PassOutput& out) const {
                    sc = hex_corner[v][2] ? -1 : 1;
       const double det = (sa * (a - x[v])).dot((sb * (b - x[v])).cross(sc * (c - x[v])));
       if (!(det > 0)) {
-        bad_parents.push_back(out.parent[h]);
+        inverted_parents.push_back(out.parent[h]);
         break;
       }
     }
   }
-  if (bad_parents.empty()) return;
-  std::sort(bad_parents.begin(), bad_parents.end());
-  bad_parents.erase(std::unique(bad_parents.begin(), bad_parents.end()), bad_parents.end());
-  std::string list;
-  for (size_t i = 0; i < bad_parents.size() && i < 20; ++i)
-    list += (i ? ", " : "") + std::to_string(bad_parents[i]);
-  if (bad_parents.size() > 20) list += ", ...";
-  throw OperationError("selective_refine: cannot refine this configuration conformally; " +
-                       std::to_string(bad_parents.size()) + " input hexes affected: " + list);
+  auto listed = [](std::vector<int32_t>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    std::string list = std::to_string(v.size()) + " input hexes affected: ";
+    for (size_t i = 0; i < v.size() && i < 20; ++i) list += (i ? ", " : "") + std::to_string(v[i]);
+    if (v.size() > 20) list += ", ...";
+    return list;
+  };
+  if (!bad_parents.empty())
+    throw OperationError("selective_refine: cannot refine this configuration conformally; " +
+                         listed(bad_parents));
+  if (!inverted_parents.empty())
+    throw OperationError(
+        "selective_refine: the templates would invert hexes here (the input "
+        "hexes are too distorted for them); " +
+        listed(inverted_parents));
 }
 
 PassOutput SelectivePass::run() {

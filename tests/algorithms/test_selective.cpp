@@ -5,8 +5,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <random>
+#include <sstream>
+#include <tuple>
 
 #include "algorithms/templates.hpp"
 #include "mesh/conformity.hpp"
@@ -349,6 +353,164 @@ TEST(Selective, RefusesInvertedInputAndBadTargets) {
   o.allow_inverted = true;
   EXPECT_NO_THROW(selective_refine(m, {{0}}, o));
   EXPECT_THROW(selective_refine(fixture_brick(1, 1, 1), {{5}}, {}), InputError);
+}
+
+}  // namespace
+}  // namespace hexrefine
+
+namespace hexrefine {
+namespace {
+
+// Writes the JSON behind results/templates.md, results/selective_random.md and
+// results/selective_cases.md. Run by hand:
+//   algorithms_tests --gtest_also_run_disabled_tests --gtest_filter='*WriteResults*'
+TEST(SelectiveResults, DISABLED_WriteResults) {
+  const std::string dir = std::string(HEXREFINE_SOURCE_DIR) + "/results/";
+  {
+    nlohmann::json j = nlohmann::json::array();
+    const HexTemplate* all[] = {&template_1_27(),       &template_1_13(), &template_1_5(),
+                                &template_1_4(),        &template_1_3(),  &template_1_3_adjust1(),
+                                &template_1_3_adjust2()};
+    for (const HexTemplate* t : all)
+      j.push_back({{"template", template_tag_name(t->tag)},
+                   {"split_edges", __builtin_popcount(template_split_edges(*t))},
+                   {"children", t->children.size()},
+                   {"min_scaled_jacobian_alone", template_validate(*t)}});
+    std::ofstream(dir + "templates.json") << j.dump(2) << "\n";
+  }
+  {
+    nlohmann::json cases = nlohmann::json::array();
+    auto record = [&](const std::string& name, const HexMesh& m, const std::vector<int32_t>& t,
+                      const RefineOptions& o = {}) {
+      nlohmann::json c = {{"case", name}, {"targets", t.size()}};
+      try {
+        const RefineResult r = selective_refine(m, {t}, o);
+        const MeshCheckReport k = mesh_check(r.mesh, &m);
+        c["stats"] = refine_stats_to_json(r.stats);
+        c["check"] = mesh_check_to_json(k);
+      } catch (const OperationError& e) {
+        c["refused"] = e.what();
+      }
+      cases.push_back(c);
+    };
+    {
+      const HexMesh m = fixture_brick(10, 10, 10);
+      std::vector<int32_t> t;
+      for (int32_t h = 0; h < m.hex_count(); ++h)
+        if (h % 10 == 0 || h / 100 == 0) t.push_back(h);
+      record("L-shaped 10x10x10 (Table G-1)", m, t);
+      RefineOptions o;
+      o.ranking = false;
+      record("L-shaped, --no-ranking", m, t, o);
+      o = {};
+      o.propagation = false;
+      record("L-shaped, --no-propagation", m, t, o);
+      o = {};
+      o.ebe_only = true;
+      record("L-shaped, --ebe-only", m, t, o);
+    }
+    for (int n : {5, 10, 15, 20, 25, 30}) {
+      BrickParams bp;
+      bp.dims = {n, n, n};
+      const HexMesh m = generate_brick(bp);
+      record("radial r=0.5 at corner, interval " + std::to_string(n) + " (Table G-3)", m,
+             hexes_within(m, {1, 1, 1}, 0.5));
+    }
+    {
+      const HexMesh m = brick_with_rotated_hexes(10, 3);
+      const std::vector<int32_t> t = hexes_within(m, {1, 1, 1}, 0.5);
+      record("radial interval 10, hexes in random local orientations", m, t);
+      RefineOptions o;
+      o.ranking = false;
+      record("radial interval 10, random orientations, --no-ranking", m, t, o);
+      o = {};
+      o.propagation = false;
+      record("radial interval 10, random orientations, --no-propagation", m, t, o);
+      o = {};
+      o.ebe_only = true;
+      record("radial interval 10, random orientations, --ebe-only", m, t, o);
+    }
+    {
+      const HexMesh gear = generate_gear({});
+      std::vector<int32_t> teeth;
+      const auto* block = mesh_find_attribute(gear, attribute_block_id);
+      for (int32_t h = 0; h < gear.hex_count(); ++h)
+        if ((*block)[h] == 2) teeth.push_back(h);
+      record("gear teeth (block 2)", gear, teeth);
+      const HexMesh cyl = generate_cylinder({});
+      record("O-grid cylinder, sphere r=0.5 at (0,0,0.5)", cyl,
+             hexes_within(cyl, {0, 0, 0.5}, 0.5));
+      for (const auto& [file, c, r] :
+           {std::tuple{"ellipsoid.mesh", Eigen::Vector3d(0, 0, 0), 0.1},
+            std::tuple{"ellipsoid.mesh", Eigen::Vector3d(0, 0, 0), 0.25},
+            std::tuple{"ellipsoid.mesh", Eigen::Vector3d(0.1, 0.1, 0.3), 0.12},
+            std::tuple{"rockerarm.mesh", Eigen::Vector3d(0, 0, 0), 8.0},
+            std::tuple{"rockerarm.mesh", Eigen::Vector3d(0, 0, 20), 10.0}}) {
+        const HexMesh m = mesh_read(shared_mesh(file));
+        std::ostringstream name;
+        name << file << ", sphere r=" << r << " at (" << c.transpose() << ")";
+        record(name.str(), m, hexes_within(m, c, r));
+      }
+      TwistedRingParams rp;
+      rp.section_intervals = 3;
+      const HexMesh ring = generate_twisted_ring(rp);
+      const HexTopology topo = topology_build(ring);
+      const DualSheets d = dual_build(ring, topo);
+      for (int32_t s = 0; s < d.sheet_count(); ++s)
+        if (d.sheets[s].self_intersecting) {
+          const auto hs = sheet_hexes(d, s);
+          record("twisted ring 3x3, the self-intersecting sheet", ring,
+                 std::vector<int32_t>(hs.begin(), hs.end()));
+          break;
+        }
+    }
+    std::ofstream(dir + "selective_cases.json") << cases.dump(2) << "\n";
+  }
+  {
+    // The random suite of SelectiveRandom.TargetSetsOnJitteredBricks, with its refusals.
+    nlohmann::json j;
+    const char* kinds[] = {
+        "uniform",    "checkerboard", "isolated", "edge-contact pairs", "vertex-contact pairs",
+        "sphere blob"};
+    std::map<std::string, std::array<int, 4>> per_kind;  // sets, refined, refused, empty
+    nlohmann::json refused = nlohmann::json::array();
+    for (int n : {4, 6}) {
+      BrickParams bp;
+      bp.dims = {n, n, n};
+      bp.size = {double(n), double(n), double(n)};
+      bp.jitter = 0.2;
+      bp.seed = 7;
+      const HexMesh m = generate_brick(bp);
+      for (uint64_t seed = 1; seed <= 1000; ++seed) {
+        const uint64_t s = seed * 7919 + n;
+        const std::vector<int32_t> t = random_targets(n, s);
+        auto& k = per_kind[std::to_string(n) + "^3 " + kinds[s % 6]];
+        ++k[0];
+        if (t.empty()) {
+          ++k[3];
+          continue;
+        }
+        try {
+          const RefineResult r = selective_refine(m, {t}, {});
+          const MeshCheckReport c = mesh_check(r.mesh, &m);
+          EXPECT_TRUE(c.valid() && c.doublets == 0);
+          ++k[1];
+        } catch (const OperationError& e) {
+          ++k[2];
+          refused.push_back({{"n", n},
+                             {"seed", s},
+                             {"kind", kinds[s % 6]},
+                             {"targets", t},
+                             {"message", e.what()}});
+        }
+      }
+    }
+    for (const auto& [name, k] : per_kind)
+      j["per_kind"][name] = {
+          {"sets", k[0]}, {"refined_valid", k[1]}, {"refused", k[2]}, {"empty", k[3]}};
+    j["refused"] = refused;
+    std::ofstream(dir + "selective_random.json") << j.dump(2) << "\n";
+  }
 }
 
 }  // namespace

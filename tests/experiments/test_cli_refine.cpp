@@ -13,6 +13,16 @@
 namespace hexrefine {
 namespace {
 
+// Joins arguments with spaces (avoids long operator+ chains, which trip GCC 12's -Wrestrict).
+std::string join(std::initializer_list<std::string> parts) {
+  std::string out;
+  for (const std::string& p : parts) {
+    if (!out.empty()) out += ' ';
+    out += p;
+  }
+  return out;
+}
+
 nlohmann::json read_json(const std::filesystem::path& p) {
   std::ifstream in(p);
   return nlohmann::json::parse(in);
@@ -22,10 +32,10 @@ TEST(CliRefine, LShapedCaseWritesMeshAndReport) {
   const auto dir = test_temp_dir("cli_refine_l");
   const std::string in = (dir / "b.vtk").string(), out = (dir / "o.vtk").string();
   mesh_write(in, fixture_brick(10, 10, 10));
-  const CliRun r = cli_run("refine " + in + " " + out +
-                           " --method selective --select boundary:-1,0,0 --select "
-                           "boundary:0,0,-1 --report " +
-                           (dir / "r.json").string());
+  const CliRun r = cli_run(join({"refine", in, out,
+                                 "--method selective --select boundary:-1,0,0 --select "
+                                 "boundary:0,0,-1 --report",
+                                 (dir / "r.json").string()}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(mesh_read(out).hex_count(), 8060);
   const nlohmann::json j = read_json(dir / "r.json");
@@ -45,10 +55,10 @@ TEST(CliRefine, AblationWritesANonConformalMeshAndCountsTheDefects) {
   const auto dir = test_temp_dir("cli_refine_ablation");
   const std::string in = (dir / "b.vtk").string(), out = (dir / "o.vtk").string();
   mesh_write(in, fixture_brick(10, 10, 10));
-  const CliRun r = cli_run("refine " + in + " " + out +
-                           " --method selective --select boundary:-1,0,0 --select "
-                           "boundary:0,0,-1 --ebe-only --report " +
-                           (dir / "r.json").string());
+  const CliRun r = cli_run(join({"refine", in, out,
+                                 "--method selective --select boundary:-1,0,0 --select "
+                                 "boundary:0,0,-1 --ebe-only --report",
+                                 (dir / "r.json").string()}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = read_json(dir / "r.json");
   EXPECT_FALSE(j.at("conformal").get<bool>());
@@ -62,7 +72,7 @@ TEST(CliRefine, EmptySelectionWritesTheMeshUnchanged) {
   const std::string in = (dir / "b.vtk").string(), out = (dir / "o.vtk").string();
   mesh_write(in, fixture_brick(2, 2, 2));
   const CliRun r =
-      cli_run("refine " + in + " " + out + " --method selective --select sphere:9,9,9,0.1");
+      cli_run(join({"refine", in, out, "--method selective --select sphere:9,9,9,0.1"}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("warning"), std::string::npos);
   EXPECT_EQ(mesh_read(out).hex_count(), 8);
@@ -73,18 +83,18 @@ TEST(CliRefine, BadUsageAndInvertedInputExitTwo) {
   const std::string in = (dir / "b.vtk").string(), out = (dir / "o.vtk").string();
   mesh_write(in, fixture_brick(2, 2, 2));
   for (const std::string& args :
-       {"refine " + in + " " + out + " --select all",
-        "refine " + in + " " + out + " --method octree --select all",
-        "refine " + in + " " + out + " --method selective",
-        "refine " + in + " --method selective --select all",
-        "refine " + in + " " + out + " --method selective --select all --passes 0",
-        "refine " + in + " " + out + " --method selective --select all --smooth"}) {
+       {join({"refine", in, out, "--select all"}),
+        join({"refine", in, out, "--method octree --select all"}),
+        join({"refine", in, out, "--method selective"}),
+        join({"refine", in, "--method selective --select all"}),
+        join({"refine", in, out, "--method selective --select all --passes 0"}),
+        join({"refine", in, out, "--method selective --select all --smooth"})}) {
     const CliRun r = cli_run(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
   }
   EXPECT_FALSE(std::filesystem::exists(out));
   const std::string inverted = shared_mesh("sphere_projected_inverted.mesh");
-  const CliRun r = cli_run("refine " + inverted + " " + out + " --method selective --select all");
+  const CliRun r = cli_run(join({"refine", inverted, out, "--method selective --select all"}));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("inverted hexes, first at id"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(out));
@@ -101,8 +111,8 @@ TEST(CliRefine, UnhandledConfigurationExitsOneNamingHexesAndWritesNothing) {
   bp.seed = 7;
   mesh_write(in, generate_brick(bp));
   std::ofstream(dir / "t.txt") << "0 2 5 8 13 15 25 37 39 47 54";
-  const CliRun r = cli_run("refine " + in + " " + out +
-                           " --method selective --select hexes:" + (dir / "t.txt").string());
+  const CliRun r = cli_run(join(
+      {"refine", in, out, "--method selective --select", "hexes:" + (dir / "t.txt").string()}));
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("input hexes affected"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(out));

@@ -31,6 +31,13 @@ std::vector<int32_t> all_hexes(const HexMesh& m) {
   return t;
 }
 
+TEST(Selective, SharedRefinerSuite) {
+  const std::vector<int64_t> sizes = refiner_suite_run(selective_refine);
+  ASSERT_EQ(sizes.size(), 6u);
+  EXPECT_EQ(sizes[2], 8060);   // L-shaped
+  EXPECT_EQ(sizes[4], 55272);  // gear teeth (thesis H-1: 63,093 on its own gear)
+}
+
 TEST(Selective, FullRefinementOfBricks) {
   for (int n : {1, 2, 3, 5}) {
     const HexMesh m = fixture_brick(n, n, n);

@@ -62,6 +62,13 @@ TEST(CliRun, ResumeOfAFinishedRunRunsNothing) {
   EXPECT_EQ(ss.str(), done);
 }
 
+TEST(CliReproduce, RefusesStrayArguments) {
+  const CliRun r = cli_run("reproduce fast");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("unexpected argument 'fast'"), std::string::npos) << r.output;
+  EXPECT_EQ(cli_run("reproduce --fast").exit_code, 2);
+}
+
 TEST(CliMerge, JoinsShardsDeduplicatedInCaseOrder) {
   const auto dir = test_temp_dir("cli_merge");
   file_put(dir / "s2.jsonl",
@@ -91,6 +98,62 @@ TEST(CliMerge, JoinsShardsDeduplicatedInCaseOrder) {
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.output.find("bad.jsonl:1: not a JSON record"), std::string::npos) << bad.output;
   EXPECT_FALSE(fs::exists(dir / "x.jsonl"));
+}
+
+}  // namespace
+}  // namespace hexrefine
+
+namespace hexrefine {
+namespace {
+
+std::string file_read(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(CliRun, RunsBothMethodsOnTheSameTargetsAndChecksTheOutputs) {
+  const auto dir = test_temp_dir("cli_run_real");
+  const std::string abaqus = shared_mesh("abaqus_hex_2x2x2.inp");
+  file_put(dir / "c.json", R"({"cases":[
+    {"name":"full","mesh":{"generate":"brick","dims":[3,3,3]},"select":["all"],"save_mesh":true},
+    {"name":"inp","mesh":{"file":")" +
+                               abaqus + R"("},"select":["all"],"methods":["selective"]},
+    {"name":"bad-spec","mesh":{"generate":"brick","dims":[2,2,2]},"select":["boxx:1"],
+     "methods":["sheet"]}],
+    "output":"r.jsonl"})");
+  const CliRun r = cli_run("run " + (dir / "c.json").string());
+  // The malformed spec is bad input: recorded, the run goes on, and it exits 2 at the end.
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("4 records written (0 already present, 1 with an error)"),
+            std::string::npos)
+      << r.output;
+  const JsonlContent c = jsonl_read((dir / "r.jsonl").string());
+  ASSERT_EQ(c.records.size(), 4u);
+  for (int i = 0; i < 2; ++i) {
+    const json& full = c.records[i];
+    EXPECT_EQ(full["method"], i == 0 ? "selective" : "sheet");
+    EXPECT_FALSE(full.contains("error")) << full.dump();
+    EXPECT_EQ(full["initial_hexes"], 27);
+    EXPECT_EQ(full["selection"]["hexes"], 27);
+    EXPECT_EQ(full["final_hexes"], 729);
+    EXPECT_EQ(full["final_nodes"], 1000);
+    EXPECT_EQ(full["conformal"], true);
+    EXPECT_EQ(full["inverted_hexes"], 0);
+    EXPECT_DOUBLE_EQ(full["min_scaled_jacobian"].get<double>(), 1.0);
+    EXPECT_EQ(full["scaled_jacobian_histogram"]["counts"][19], 729);
+    EXPECT_EQ(full["input"]["generate"], "brick");
+    EXPECT_EQ(full["input"]["dims"], json({3, 3, 3}));
+    EXPECT_TRUE(fs::exists(dir / "r.meshes" / run_mesh_file_name("full", full["method"])));
+  }
+  const json& inp = c.records[2];
+  EXPECT_EQ(inp["final_hexes"], 216);
+  EXPECT_EQ(inp["input"]["sha256"], sha256_hex(file_read(abaqus)));
+  EXPECT_EQ(inp["conformal"], true);
+  const json& bad = c.records[3];
+  EXPECT_EQ(bad["error_kind"], "input");
+  EXPECT_NE(bad["error"].get<std::string>().find("boxx"), std::string::npos);
 }
 
 }  // namespace

@@ -111,6 +111,7 @@ TEST(RunPlan, ParsesDefaultsAndResolvesRelativePaths) {
                         {"methods", {"sheet"}},
                         {"passes", 3},
                         {"smooth", true},
+         {"save_mesh", true},
                         {"options", {{"buffer", true}, {"ranking", false}}},
                         {"tags", {{"table", "X"}}}}}},
                      {"output", "out/r.jsonl"}};
@@ -131,6 +132,8 @@ TEST(RunPlan, ParsesDefaultsAndResolvesRelativePaths) {
   EXPECT_TRUE(b.options.buffer);
   EXPECT_FALSE(b.options.ranking);
   EXPECT_TRUE(b.smooth);
+  EXPECT_TRUE(b.save_mesh);
+  EXPECT_FALSE(a.save_mesh);
   EXPECT_EQ(b.tags["table"], "X");
   EXPECT_EQ(plan.output, (dir / "out" / "r.jsonl").string());
   // Without "output": beside the case file, named after it.
@@ -385,6 +388,11 @@ TEST(RunShard, ShardsPartitionTheCasesAndMergeRestoresTheOrder) {
   EXPECT_EQ(merged[6]["final_hexes"], -7);
   jsonl_write((dir / "merged.jsonl").string(), merged);
   EXPECT_EQ(jsonl_read((dir / "merged.jsonl").string()).records, merged);
+}
+
+TEST(RunMeshFileName, ReplacesPathCharacters) {
+  EXPECT_EQ(run_mesh_file_name("G-3/n=20", "selective"), "G-3_n=20.selective.vtu");
+  EXPECT_EQ(run_mesh_file_name("a b:c", "sheet"), "a_b_c.sheet.vtu");
 }
 
 TEST(ScaledJacobianHistogram, FixedBins) {

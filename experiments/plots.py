@@ -300,15 +300,20 @@ def ablation_table(records, groups, out):
     out.append("| base case | variant | final hexes | directional hexes | doublets resolved | "
                "time (s) | min scaled Jacobian | check |")
     out.append("|---|---|---:|---:|---:|---:|---:|---|")
+    bases = []
     for r in rows:
-        tags = r.get("tags", {})
-        base = record_of(records, tags.get("base"), "selective")
-        for variant, x in (("baseline", base), (tags.get("variant"), r)):
-            if variant == "baseline" and (x is None or tags.get("variant") != "no-ranking"):
-                continue  # the baseline row once per base case
+        base = r.get("tags", {}).get("base")
+        if base not in bases:
+            bases.append(base)
+    for base in bases:
+        # The unablated run first (the base case's own selective record), then each variant.
+        lines = [("baseline", record_of(records, base, "selective"))]
+        lines += [(r.get("tags", {}).get("variant"), r) for r in rows
+                  if r.get("tags", {}).get("base") == base]
+        for variant, x in lines:
             ok = x is not None and "error" not in x
             out.append("| %s | %s | %s | %s | %s | %s | %s | %s |" % (
-                tags.get("base"), variant, fmt(x.get("final_hexes") if ok else None),
+                base, variant, fmt(x.get("final_hexes") if ok else None),
                 fmt(x.get("directional_hexes") if ok else None),
                 fmt(x.get("doublets_resolved") if ok else None),
                 fmt(x.get("time_seconds") if ok else None),

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -154,6 +155,72 @@ TEST(CliRun, RunsBothMethodsOnTheSameTargetsAndChecksTheOutputs) {
   const json& bad = c.records[3];
   EXPECT_EQ(bad["error_kind"], "input");
   EXPECT_NE(bad["error"].get<std::string>().find("boxx"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hexrefine
+
+namespace hexrefine {
+namespace {
+
+/// Runs experiments/plots.py (matplotlib is a CI dependency, .ci/setup.sh).
+CliRun plots_py(const std::string& args) {
+  const std::string cmd = std::string("/usr/bin/python3 ") + HEXREFINE_SOURCE_DIR +
+                          "/experiments/plots.py " + args + " 2>&1";
+  CliRun r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+TEST(PlotsPy, PutsOursBesideTheThesisWithRatios) {
+  const auto dir = test_temp_dir("plots_py");
+  auto g1 = [](const std::string& method, int final_hexes, double seconds, double min_sj) {
+    json r = record("G-1", 0, method, method == "selective" ? 0 : 1);
+    r["tags"] = {{"table", "G-1"}};
+    r["initial_hexes"] = 1000;
+    r["final_hexes"] = final_hexes;
+    r["time_seconds"] = seconds;
+    r["min_scaled_jacobian"] = min_sj;
+    r["input"] = {{"generate", "brick"}, {"initial_min_scaled_jacobian", 1.0}};
+    r["conformal"] = true;
+    r["inverted_hexes"] = 0;
+    return r;
+  };
+  json sweep = record("G-2/n=10", 1, "sheet", 1);
+  sweep["tags"] = {{"table", "G-2"}, {"n", 10}};
+  sweep["initial_hexes"] = 1000;
+  sweep["error"] = "sheet refinement refused";
+  file_put(dir / "r.jsonl", g1("selective", 8060, 0.0797, 0.3077).dump() + "\n" +
+                                g1("sheet", 27000, 3.242, 1.0).dump() + "\n" + sweep.dump() + "\n");
+  const std::string thesis = std::string(HEXREFINE_SHARED_DIR) + "/thesis/tables.json";
+  const CliRun r = plots_py((dir / "r.jsonl").string() + " --thesis " + thesis + " --out " +
+                            (dir / "out").string() + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir / "out" / "tables.md");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string md = ss.str();
+  // Thesis G-1: sheet 27,000 hexes in 6.484 s, selective 8,060 in 0.797 s (ratios ours/thesis).
+  EXPECT_NE(md.find("| Final element count | 27,000 | 27,000 | 1 | 8,060 | 8,060 | 1 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| Time (s) | 6.484 | 3.242 | 0.5 | 0.797 | 0.0797 | 0.1 |"), std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| 10 | 1,000 | 0.27 | – | – | 1 | – | – |"), std::string::npos) << md;
+  EXPECT_NE(md.find("error: sheet refinement refused"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "out" / "plots" / "G-2_time.png"));
+
+  file_put(dir / "bad.jsonl", "nonsense\n{}\n");
+  const CliRun bad = plots_py((dir / "bad.jsonl").string() + " --thesis " + thesis + " --out " +
+                              (dir / "out").string());
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.output.find("bad.jsonl:1: not a JSON record"), std::string::npos) << bad.output;
 }
 
 }  // namespace

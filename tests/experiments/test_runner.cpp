@@ -285,6 +285,21 @@ TEST(RunPlanExecute, WritesOneRecordPerCaseAndMethod) {
   EXPECT_EQ(jsonl_read(out).records.size(), 6u);
 }
 
+TEST(RunPlanExecute, ReportsProgressCaseByCase) {
+  const auto dir = test_temp_dir("runner_progress");
+  const RunPlan plan = fake_plan(3, (dir / "r.jsonl").string());
+  std::ostringstream progress;
+  RunSettings settings = quiet_settings();
+  settings.progress = &progress;
+  FakeExecutor fake;
+  run_plan_execute(plan, settings, std::ref(fake));
+  const std::string text = progress.str();
+  EXPECT_EQ(text.rfind("[case 1 of 3] c0 (2 methods)  elapsed ", 0), 0u) << text;
+  EXPECT_NE(text.find("[case 3 of 3] c2 (2 methods)"), std::string::npos) << text;
+  EXPECT_NE(text.find(" s left"), std::string::npos) << text;  // an estimate once one case is done
+  EXPECT_NE(text.find("done: 6 records in "), std::string::npos) << text;
+}
+
 TEST(RunPlanExecute, ResumeAfterKilledRunLosesNothingAndRepeatsNothing) {
   const auto dir = test_temp_dir("runner_resume");
   const std::string out = (dir / "r.jsonl").string();

@@ -1,14 +1,83 @@
 #pragma once
 /// \file
-/// Harris-style sheet refinement (thesis chapter 4, Appendices C and D). See sheet.cpp.
+/// Harris-style sheet refinement (Parrish, BYU MS thesis, chapter 2, chapter 4, Appendices C, D,
+/// E, G; after Harris' template-based sheet refinement). See sheet.cpp for the steps and the
+/// reading of the thesis this implementation makes.
+
+#include <cstdint>
+#include <functional>
+#include <vector>
 
 #include "algorithms/refiner.hpp"
+#include "mesh/hex_mesh.hpp"
+#include "mesh/topology.hpp"
 
 namespace hexrefine {
 
-/// Refines `targets` of `mesh` one direction at a time, sheet by sheet. Throws OperationError
-/// naming the sheet and hexes for a case it refuses (never returns a broken mesh).
+/// What one direction of one hex needs in a sheet pass, from which of its four parallel edges
+/// (the edges of local axis k) are split.
+enum class SheetPattern : int8_t {
+  none,                ///< no edge split: the hex is not touched in this direction
+  one_to_five,         ///< one edge split: directional 1-5
+  one_to_four,         ///< two edges on one face split: directional 1-4
+  one_to_three,        ///< all four split: directional 1-3
+  multiply_connected,  ///< three, or two diagonal: no directional template (Harris had none)
+};
+
+/// The pattern of local axis `axis` (0..2) of a hex whose split local edges are the bits of
+/// `split_mask` (bit e = local edge e of hex_convention.hpp; bits of other axes are ignored).
+SheetPattern hex_axis_pattern(uint16_t split_mask, int axis);
+
+/// Split mask of hex `h`: bit e set when both end nodes of local edge e are marked.
+/// `node_marked` has one entry per mesh node.
+uint16_t hex_split_mask(const HexMesh& mesh, const std::vector<uint8_t>& node_marked, int32_t h);
+
+/// True if some direction of the hex (split mask as above) is multiply connected.
+bool hex_is_multiply_connected(uint16_t split_mask);
+
+/// Harris' marking and target growth on the original mesh.
+struct SheetMarking {
+  std::vector<uint8_t> node_marked;  ///< per node: 1 if a node of a (grown) target hex
+  std::vector<uint8_t> hex_target;   ///< per hex: 1 if a target, given or added
+  int64_t added_targets = 0;         ///< hexes added to remove multiply-connected transitions
+};
+
+/// Marks the nodes of the targets, then adds every hex that is a multiply-connected transition
+/// (hex_is_multiply_connected of its split mask) to the targets, marking its nodes, until none
+/// is left. Worklist over the hexes around newly marked nodes: linear in the size of the grown
+/// region. Precondition: `targets` valid for `mesh` (ascending, unique, in range), `topology`
+/// built from `mesh`.
+SheetMarking sheet_mark(const HexMesh& mesh, const HexTopology& topology, const Targets& targets);
+
+/// Called after every sheet round with the whole intermediate mesh (conformal by construction)
+/// and the round index; for tests and figures. Assembling the mesh costs a copy per round.
+using SheetRoundObserver = std::function<void(const HexMesh& mesh, int round)>;
+
+/// Refines `targets` of `mesh` one direction at a time, sheet by sheet. Output attributes:
+/// those of the input, inherited; "template_tag" = TemplateTag::sheet on every hex produced by
+/// sheet passes (untouched hexes keep theirs, or 0); "refinement_level" = the parent's + 1 per
+/// pass (options.passes). A dual sheet crossing itself in a fully refined hex is handled (both
+/// directions in one pass, template 1-9); stats.self_intersection_cases counts the refined hexes
+/// a dual sheet crosses itself in. Throws InputError for invalid targets, OperationError naming
+/// the sheet and hexes for a case it refuses (a sheet crossing itself in a transition hex that
+/// it must refine in two directions): never returns a non-conformal mesh.
 RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets,
                           const RefineOptions& options);
+
+/// As above, with an observer of the intermediate meshes.
+RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
+                          const SheetRoundObserver& observer);
+
+/// How the sheet passes are scheduled and watched (tests, figures, studies).
+struct SheetControl {
+  SheetRoundObserver observer;  ///< called after every round, if set
+  /// Harris' order: one sheet piece per round, in piece order, instead of all the pieces that
+  /// share no hex together. Same result; one copy of the refined region per sheet (slower).
+  bool one_sheet_per_round = false;
+};
+
+/// As above, with a schedule and an observer.
+RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
+                          const SheetControl& control);
 
 }  // namespace hexrefine

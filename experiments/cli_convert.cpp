@@ -10,10 +10,7 @@
 #include "experiments/cli.hpp"
 #include "mesh/error.hpp"
 #include "mesh/io.hpp"
-#if __has_include("mesh/quality.hpp")
 #include "mesh/quality.hpp"
-#define HEXREFINE_HAVE_QUALITY 1
-#endif
 
 namespace hexrefine {
 
@@ -31,10 +28,8 @@ int cli_convert(const std::vector<std::string>& args) {
   if (options.binary && out_format != MeshFormat::vtk_legacy)
     throw InputError("hexrefine convert: --binary applies to .vtk output only (" + out + ")");
   const HexMesh mesh = mesh_read(in);
-#ifdef HEXREFINE_HAVE_QUALITY
   if (out_format == MeshFormat::vtk_legacy || out_format == MeshFormat::vtu)
     options.cell_scalars.emplace_back("scaled_jacobian", mesh_scaled_jacobians(mesh));
-#endif
   mesh_write(out, mesh, options);
   std::cout << "converted " << in << " -> " << out << ": " << mesh.point_count() << " nodes, "
             << mesh.hex_count() << " hexes\n";

@@ -8,11 +8,7 @@
 #include "experiments/cli.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"
-
-#if __has_include("mesh/io.hpp")
 #include "mesh/io.hpp"
-#define HEXREFINE_HAVE_IO 1
-#endif
 
 namespace hexrefine {
 
@@ -41,13 +37,7 @@ const char* generate_usage =
 
 // Writes `mesh` to `path` and reports the counts on stdout.
 int generate_write(const std::string& path, const HexMesh& mesh) {
-#ifdef HEXREFINE_HAVE_IO
   mesh_write(path, mesh);
-#else
-  (void)path;
-  throw OperationError("hexrefine generate: cannot write " + path +
-                       ": the mesh writer (mesh/io.hpp) is not built into this version");
-#endif
   std::cout << "wrote " << path << ": " << mesh.hex_count() << " hexes, " << mesh.point_count()
             << " nodes\n";
   return 0;

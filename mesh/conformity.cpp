@@ -44,19 +44,24 @@ double quad_area(const Quad& q) {
   return area;
 }
 
-/// Out-of-plane spread of the four corners (along the normal of the diagonals) over the diameter.
-double quad_relative_warp(const Quad& q) {
-  const double diameter = quad_diameter(q);
+/// Out-of-plane spread of the four corners along the normal of the diagonals (0 if degenerate).
+double quad_warp(const Quad& q) {
   const Eigen::Vector3d n = (q[2] - q[0]).cross(q[3] - q[1]);
   const double n_norm = n.norm();
-  if (!(n_norm > 0.0) || !(diameter > 0.0)) return 0.0;  // degenerate: collinear points are planar
+  if (!(n_norm > 0.0)) return 0.0;  // collinear diagonals: the points span no plane to leave
   double lo = 0.0, hi = 0.0;
   for (int i = 1; i < 4; ++i) {
     const double d = (q[i] - q[0]).dot(n) / n_norm;
     lo = std::min(lo, d);
     hi = std::max(hi, d);
   }
-  return (hi - lo) / diameter;
+  return hi - lo;
+}
+
+/// quad_warp over the diameter.
+double quad_relative_warp(const Quad& q) {
+  const double diameter = quad_diameter(q);
+  return diameter > 0.0 ? quad_warp(q) / diameter : 0.0;
 }
 
 /// Distance from p to the bilinear patch q, by Gauss-Newton on (u, v) clamped to [0,1]^2. Exact
@@ -193,7 +198,10 @@ BoundarySurface boundary_surface(const HexMesh& mesh, const HexTopology& t) {
     const auto& n = t.face_nodes[f];
     s.nodes.push_back(n);
     s.quads.push_back({mesh.points[n[0]], mesh.points[n[1]], mesh.points[n[2]], mesh.points[n[3]]});
-    s.tolerances.push_back(mesh_check_surface_tolerance * quad_diameter(s.quads.back()));
+    // A point averaged from patch points (a sub-face centroid, a node placed by a template whose
+    // footprint is not a parameter rectangle) can leave a warped patch by up to its warp.
+    s.tolerances.push_back(mesh_check_surface_tolerance * quad_diameter(s.quads.back()) +
+                           quad_warp(s.quads.back()));
   }
   return s;
 }
@@ -209,43 +217,71 @@ double mesh_volume(const HexMesh& mesh) {
   return volume;
 }
 
-/// Nodes within mesh_check_duplicate_tolerance x diagonal of a lower-id node, by sorting the
-/// positions quantised to the tolerance and searching the 27 neighbouring cells.
+/// Nodes within mesh_check_duplicate_tolerance x diagonal of a lower-id node. Points are sorted
+/// by a coarse cell (about one point per cell); near pairs share a cell unless they straddle a
+/// cell wall, so only points within the tolerance of a wall also search the neighbouring cells.
+/// The cell size is an irrational multiple of the mean spacing so structured grids do not put
+/// their points on the walls. Worst case (many points in one cell) is quadratic in that cell.
 int64_t count_duplicate_nodes(const HexMesh& mesh) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
   const auto [lo, hi] = mesh_bounding_box(mesh);
   const double tolerance = mesh_check_duplicate_tolerance * (hi - lo).norm();
-  const double cell = tolerance > 0.0 ? tolerance : 1.0;
-  using Key = std::array<int64_t, 3>;
-  std::vector<std::pair<Key, int32_t>> sorted(n);
-  for (int32_t i = 0; i < n; ++i) {
-    Key k;
-    for (int d = 0; d < 3; ++d)
-      k[d] = static_cast<int64_t>(std::floor((mesh.points[i][d] - lo[d]) / cell));
-    sorted[i] = {k, i};
-  }
-  std::sort(sorted.begin(), sorted.end());
-  int64_t duplicates = 0;
+  const double extent = (hi - lo).maxCoeff();
+  const double cell =
+      std::max({1.6180339887 * extent / std::cbrt(static_cast<double>(n)), 4.0 * tolerance,
+                extent / double(1 << 20), std::numeric_limits<double>::min() * 1e10});
+  const Eigen::Vector3d origin = lo - Eigen::Vector3d::Constant(0.3819660113 * cell);
+  auto cell_index = [&](double x, int d) {
+    return static_cast<int64_t>(std::floor((x - origin[d]) / cell));
+  };
+  auto pack = [](int64_t x, int64_t y, int64_t z) {
+    const uint64_t mask = 0x1FFFFF;  // indices stay in [0, 2^20 + 2) by the cell size above
+    return ((static_cast<uint64_t>(x) & mask) << 42) | ((static_cast<uint64_t>(y) & mask) << 21) |
+           (static_cast<uint64_t>(z) & mask);
+  };
+  std::vector<std::pair<uint64_t, int32_t>> sorted(n);
   for (int32_t i = 0; i < n; ++i) {
     const Eigen::Vector3d& p = mesh.points[i];
-    Key k;
-    for (int d = 0; d < 3; ++d) k[d] = static_cast<int64_t>(std::floor((p[d] - lo[d]) / cell));
-    bool duplicate = false;
-    for (int dz = -1; dz <= 1 && !duplicate; ++dz)
-      for (int dy = -1; dy <= 1 && !duplicate; ++dy)
-        for (int dx = -1; dx <= 1 && !duplicate; ++dx) {
-          const Key c = {k[0] + dx, k[1] + dy, k[2] + dz};
-          auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(c, int32_t{-1}));
-          for (; it != sorted.end() && it->first == c && it->second < i; ++it)
-            if ((mesh.points[it->second] - p).norm() <= tolerance) {
-              duplicate = true;
-              break;
-            }
-        }
-    duplicates += duplicate;
+    sorted[i] = {pack(cell_index(p[0], 0), cell_index(p[1], 1), cell_index(p[2], 2)), i};
   }
-  return duplicates;
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<char> duplicate(n, 0);
+  auto compare = [&](int32_t i, int32_t j) {
+    if (i != j && (mesh.points[i] - mesh.points[j]).norm() <= tolerance)
+      duplicate[std::max(i, j)] = 1;
+  };
+  for (size_t begin = 0; begin < sorted.size();) {
+    size_t end = begin + 1;
+    while (end < sorted.size() && sorted[end].first == sorted[begin].first) ++end;
+    for (size_t a = begin; a < end; ++a)
+      for (size_t b = a + 1; b < end; ++b) compare(sorted[a].second, sorted[b].second);
+    begin = end;
+  }
+  for (int32_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = mesh.points[i];
+    int64_t k[3];
+    int low[3], high[3];
+    bool near_wall = false;
+    for (int d = 0; d < 3; ++d) {
+      k[d] = cell_index(p[d], d);
+      const double wall = origin[d] + static_cast<double>(k[d]) * cell;
+      low[d] = p[d] - wall <= tolerance ? -1 : 0;
+      high[d] = wall + cell - p[d] <= tolerance ? 1 : 0;
+      near_wall = near_wall || low[d] || high[d];
+    }
+    if (!near_wall) continue;
+    for (int dz = low[2]; dz <= high[2]; ++dz)
+      for (int dy = low[1]; dy <= high[1]; ++dy)
+        for (int dx = low[0]; dx <= high[0]; ++dx) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const uint64_t key = pack(k[0] + dx, k[1] + dy, k[2] + dz);
+          auto it =
+              std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(key, int32_t{-1}));
+          for (; it != sorted.end() && it->first == key; ++it) compare(i, it->second);
+        }
+  }
+  return std::count(duplicate.begin(), duplicate.end(), 1);
 }
 
 }  // namespace

@@ -17,7 +17,9 @@
 ///     (e.g. one hex moved away from its neighbour) cannot be told from true boundary without a
 ///     reference and is not detected.
 ///   "Lies on a face" = distance to the face's bilinear patch <= mesh_check_surface_tolerance
-///   times the face's longer diagonal.
+///   times the face's longer diagonal, plus the face's warp (out-of-plane spread of its corners):
+///   on a warped face a centroid of patch points, or a node a template placed by averaging, is off
+///   the patch by up to the warp, and must not be mistaken for a gap.
 /// - hanging node (T-junction): a node of a non-conformal face that lies on another non-conformal
 ///   face B, is not one of B's nodes, and is farther than the tolerance from each of B's corners
 ///   (a different node at a corner's position is a duplicate node, not a hanging node). Each node

@@ -1,6 +1,5 @@
 #include "mesh/generators.hpp"
 
-#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -11,6 +10,7 @@
 
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
 
 namespace hexrefine {
 
@@ -35,35 +35,21 @@ void count_require(double count, const char* generator, const char* what) {
   throw InputError(s.str());
 }
 
-// Corner Jacobians relative to the product of the edge lengths must be at least this: the same
-// sign test as "scaled Jacobian > 0", with a margin so that round-off in another implementation
-// of the metric cannot flip a nearly flat corner.
-constexpr double corner_min_scaled = 1e-6;
+// Validity threshold on hex_scaled_jacobian: positive with a margin, so that round-off in a later
+// re-evaluation (another platform, a file round trip) cannot flip a nearly flat hex to <= 0.
+constexpr double hex_min_valid_scaled_jacobian = 1e-6;
 
-// True if every corner of the hex has a positive scaled Jacobian: at vertex v the three edges
-// along +x, +y, +z (hex_vertex_edges, oriented by hex_edges) form a right-handed frame.
-bool hex_corners_positive(const std::array<Eigen::Vector3d, 8>& p) {
-  for (int v = 0; v < 8; ++v) {
-    Eigen::Vector3d e[3];
-    double length_product = 1.0;
-    for (int k = 0; k < 3; ++k) {
-      const int le = hex_vertex_edges[v][k];
-      e[k] = p[hex_edges[le][1]] - p[hex_edges[le][0]];
-      length_product *= e[k].norm();
-    }
-    if (!(length_product > 0.0)) return false;
-    if (!(e[0].dot(e[1].cross(e[2])) > corner_min_scaled * length_product)) return false;
-  }
-  return true;
+bool hex_is_valid(const std::array<Eigen::Vector3d, 8>& p) {
+  return hex_scaled_jacobian(p) > hex_min_valid_scaled_jacobian;
 }
 
 // Throws OperationError naming the first hex with a non-positive corner: a generator that
 // reaches this has parameters at the edge of its range and must not hand out an inverted mesh.
 void mesh_require_valid(const HexMesh& mesh, const char* generator) {
   for (int32_t h = 0; h < mesh.hex_count(); ++h)
-    if (!hex_corners_positive(hex_points(mesh, h)))
+    if (!hex_is_valid(hex_points(mesh, h)))
       throw OperationError(std::string(generator) + ": hex " + std::to_string(h) +
-                           " has a non-positive corner Jacobian with these parameters");
+                           " has a non-positive scaled Jacobian with these parameters");
 }
 
 // Uniform double in [0, 1) from the top 53 bits of one raw draw: the std distributions are
@@ -164,7 +150,7 @@ HexMesh generate_brick(const BrickParams& params) {
   for (int round = 0; !check.empty(); ++round) {
     moved_nodes.clear();
     for (int32_t hx : check)
-      if (!hex_corners_positive(hex_points(m, hx)))
+      if (!hex_is_valid(hex_points(m, hx)))
         for (int32_t n : m.hexes[hx])
           if (!moved[n] && offset[n] != Eigen::Vector3d::Zero()) {
             moved[n] = 1;

@@ -122,7 +122,7 @@ HexMesh generate_twisted_ring(const TwistedRingParams& params);
 /// steps share the left face x = 0. The inner corner of each step (where a riser meets the tread
 /// below) gives multiply-connected transition hexes when the right boundary is refined.
 /// Hexes = depth * step_layers * sum over s of the widths; defaults: 12 * 3 * (9 + 11 + 13) =
-/// 1,188 in an 13 x 12 x 9 bounding box of `cell`-sized cubes.
+/// 1,188 in a 13 x 12 x 9 bounding box of `cell`-sized cubes.
 struct SteppedParams {
   int steps = 3;        ///< >= 1
   int step_layers = 3;  ///< hex layers per step, >= 1

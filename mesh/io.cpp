@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -58,6 +59,20 @@ int64_t IdIndex::find(int64_t id) const {
   return it->second;
 }
 
+std::vector<int32_t> id_permutation_slots(const std::vector<int64_t>& ids) {
+  const int64_t n = static_cast<int64_t>(ids.size());
+  if (n > INT32_MAX) return {};
+  std::vector<int32_t> slot(ids.size());
+  std::vector<char> seen(ids.size(), 0);
+  for (int64_t i = 0; i < n; ++i) {
+    const int64_t t = ids[i];
+    if (t < 1 || t > n || seen[t - 1]) return {};
+    seen[t - 1] = 1;
+    slot[i] = static_cast<int32_t>(t - 1);
+  }
+  return slot;
+}
+
 void mesh_check_read(const HexMesh& mesh, const std::string& path) {
   mesh_validate_ids(mesh, path);
   const HexTopology t = topology_build(mesh);
@@ -89,16 +104,16 @@ std::string extension_of(const std::string& path) {
   return ext;
 }
 
-/// Names travel inside VTK headers, XML attributes and Gmsh strings: keep them to one safe word.
+/// Names travel inside VTK headers (no white space), XML attributes and Gmsh strings (no quotes
+/// or markup characters): printable ASCII without ' " < > &, at most 128 characters.
 void name_check(const std::string& path, const std::string& name) {
-  bool ok = !name.empty() && name.size() <= 64;
+  bool ok = !name.empty() && name.size() <= 128;
   for (char c : name)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ||
-          c == '+'))
+    if (c <= ' ' || c > '~' || c == '"' || c == '\'' || c == '<' || c == '>' || c == '&')
       ok = false;
   if (!ok)
     throw InputError(path + ": cannot write field name '" + name +
-                     "': use 1-64 letters, digits, '_', '-', '.' or '+'");
+                     "': use 1-128 printable characters without white space, quotes, <, > or &");
 }
 
 }  // namespace
@@ -117,7 +132,11 @@ MeshFormat mesh_format_of(const std::string& path) {
 }
 
 HexMesh mesh_read(const std::string& path) {
-  switch (mesh_format_of(path)) {
+  const MeshFormat format = mesh_format_of(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path + ": is a folder, expected a mesh file");
+  switch (format) {
     case MeshFormat::medit:
       return io_detail::medit_read(path);
     case MeshFormat::vtk_legacy:

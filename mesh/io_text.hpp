@@ -222,6 +222,24 @@ class IdIndex {
   bool is_dense_ = true;
 };
 
+/// When `ids` is a permutation of 1..n: slot i = ids[i] - 1 for every item; otherwise empty.
+/// Readers use it to put items with such ids in id order (files written by other tools, e.g.
+/// gmsh, may list nodes in another order than their tags).
+std::vector<int32_t> id_permutation_slots(const std::vector<int64_t>& ids);
+
+/// Reorders `items` (one per id) into id order when id_permutation_slots(ids) is not empty, and
+/// rewrites `ids` to 1..n to match. Returns whether it reordered.
+template <class T>
+bool items_sort_by_permutation_ids(std::vector<T>& items, std::vector<int64_t>& ids) {
+  const std::vector<int32_t> slot = id_permutation_slots(ids);
+  if (slot.empty() || slot.size() != items.size()) return false;
+  std::vector<T> sorted(items.size());
+  for (size_t i = 0; i < items.size(); ++i) sorted[slot[i]] = std::move(items[i]);
+  items = std::move(sorted);
+  for (size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<int64_t>(i) + 1;
+  return true;
+}
+
 /// The checks every reader ends with: ids in range and distinct per hex (mesh_validate_ids), no
 /// face shared by more than two hexes (message names the face's nodes, 0-based).
 void mesh_check_read(const HexMesh& mesh, const std::string& path);

@@ -643,7 +643,9 @@ HexMesh vtu_read(const std::string& path) {
     if (format != "ascii")
       fail_at(p, "DataArray '" + name + "' has format \"" + format +
                      "\": only format=\"ascii\" VTU files are read");
-    TextCursor in(path, all.substr(tag_end + 1, close - tag_end - 1));
+    // The values end at the first nested element (VTK writes <InformationKey> after them).
+    const size_t values_end = std::min(close, all.find('<', tag_end + 1));
+    TextCursor in(path, all.substr(tag_end + 1, values_end - tag_end - 1));
     in.set_line(line_of(all, tag_end + 1));
     const std::string what = "values of DataArray '" + name + "'";
     static const std::pair<const char*, const char*> type_names[] = {
@@ -681,7 +683,8 @@ HexMesh vtu_read(const std::string& path) {
       cell_arrays.push_back({name, tag_end + 1, in.line(), legacy_type});
       if (comps != "" && comps != "1") cell_arrays.back().type = "";  // multi-component: skipped
     }
-    if (!in.at_end() && section != in_cell_data) in.fail("more values than expected in " + what);
+    if (section >= 0 && !in.at_end() && (section == in_points || section == in_cells))
+      in.fail("more values than expected in " + what);
     p = close;
   }
   if (!have_points) fail_at(piece, "no <Points> DataArray");
@@ -724,7 +727,7 @@ HexMesh vtu_read(const std::string& path) {
     if (a.type.empty() || !vtk_type_is_integer(a.type) || a.name.empty() ||
         mesh_find_attribute(st.mesh, a.name))
       continue;
-    const size_t close = all.find("</DataArray>", a.begin);
+    const size_t close = std::min(all.find("</DataArray>", a.begin), all.find('<', a.begin));
     TextCursor in(path, all.substr(a.begin, close - a.begin));
     in.set_line(a.line);
     vtk_read_array(in, false, st, true, a.name, a.type, 1, nc);

@@ -4,6 +4,7 @@
 
 #include "cli_runner.hpp"
 #include "mesh/io.hpp"
+#include "mesh/quality.hpp"
 
 namespace hexrefine {
 namespace {
@@ -21,6 +22,35 @@ TEST(CliConvert, ConvertsSharedMeshToEveryFormat) {
   const CliRun r = cli_run("convert " + shared_mesh("rockerarm.mesh") + " " + bin + " --binary");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(mesh_read(bin).hex_count(), 10600);
+}
+
+/// The values of the double cell array `name` in an ASCII VTK legacy file written by hexrefine.
+std::vector<double> vtk_cell_doubles(const std::string& path, const std::string& name) {
+  std::ifstream in(path);
+  std::string word;
+  while (in >> word)
+    if (word == "SCALARS" && (in >> word) && word == name) break;
+  std::vector<double> out;
+  std::string type, lookup, table;
+  in >> type >> word >> lookup >> table;  // "double 1 LOOKUP_TABLE default"
+  double v;
+  while (in >> v) out.push_back(v);
+  return out;
+}
+
+TEST(CliConvert, VtkOutputCarriesScaledJacobian) {
+  const auto dir = test_temp_dir("cli_convert_quality");
+  const std::string out = (dir / "sphere.vtk").string();
+  const CliRun r = cli_run("convert " + shared_mesh("sphere_projected_inverted.mesh") + " " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const HexMesh m = mesh_read(shared_mesh("sphere_projected_inverted.mesh"));
+  const std::vector<double> expected = mesh_scaled_jacobians(m);
+  const std::vector<double> written = vtk_cell_doubles(out, "scaled_jacobian");
+  ASSERT_EQ(written.size(), 111u);
+  for (size_t h = 0; h < written.size(); ++h) EXPECT_EQ(written[h], expected[h]) << h;
+  int bad = 0;
+  for (double q : written) bad += q <= 0;
+  EXPECT_EQ(bad, 76);  // the README: 76 of its hexes are inverted or degenerate
 }
 
 TEST(CliConvert, BadInputExitsTwoNamingTheFile) {

@@ -6,13 +6,21 @@
 #include "mesh/generators.hpp"
 #include "tests/cli_runner.hpp"
 
-#if __has_include("mesh/io.hpp")
 #include "mesh/io.hpp"
-#define HEXREFINE_HAVE_IO 1
-#endif
 
 namespace hexrefine {
 namespace {
+
+// "generate ARGS" with the word OUT (if any) replaced by `out`.
+std::string generate_args(const std::string& args, const std::string& out) {
+  std::string result = "generate ";
+  const size_t at = args.find("OUT");
+  if (at == std::string::npos) return result + args;
+  result.append(args, 0, at);
+  result += out;
+  result.append(args, at + 3, std::string::npos);
+  return result;
+}
 
 TEST(CliGenerate, BadUsageExitsTwoAndWritesNothing) {
   const auto dir = test_temp_dir("cli_generate_bad");
@@ -38,8 +46,7 @@ TEST(CliGenerate, BadUsageExitsTwoAndWritesNothing) {
       {"sphere OUT", "unknown kind"},
   };
   for (const auto& c : cases) {
-    std::string args = std::string("generate ") + c.args;
-    if (const size_t at = args.find("OUT"); at != std::string::npos) args.replace(at, 3, out);
+    const std::string args = generate_args(c.args, out);
     const CliRun r = cli_run(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
     EXPECT_NE(r.output.find(c.message), std::string::npos) << args << "\n" << r.output;
@@ -52,9 +59,6 @@ TEST(CliGenerate, BadUsageExitsTwoAndWritesNothing) {
 }
 
 TEST(CliGenerate, WritesReadableMeshes) {
-#ifndef HEXREFINE_HAVE_IO
-  GTEST_SKIP() << "mesh/io.hpp (mesh_write/mesh_read) has not landed yet";
-#else
   const auto dir = test_temp_dir("cli_generate_ok");
   const struct {
     std::string args;
@@ -69,9 +73,11 @@ TEST(CliGenerate, WritesReadableMeshes) {
   };
   int i = 0;
   for (const auto& c : cases) {
-    const std::string out = (dir / ("m" + std::to_string(i++) + ".vtk")).string();
-    std::string args = "generate " + c.args;
-    args.replace(args.find("OUT"), 3, out);
+    std::string name = "m";
+    name += std::to_string(i++);
+    name += ".vtk";
+    const std::string out = (dir / name).string();
+    const std::string args = generate_args(c.args, out);
     const CliRun r = cli_run(args);
     ASSERT_EQ(r.exit_code, 0) << args << "\n" << r.output;
     const HexMesh m = mesh_read(out);
@@ -89,7 +95,6 @@ TEST(CliGenerate, WritesReadableMeshes) {
   ASSERT_EQ(m.point_count(), expected.point_count());
   for (int32_t n = 0; n < m.point_count(); ++n)
     EXPECT_TRUE(m.points[n].isApprox(expected.points[n], 1e-12)) << n;
-#endif
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "mesh/generators.hpp"
 #include "mesh/hex_convention.hpp"
 #include "tests/fixtures.hpp"
 
@@ -113,6 +114,18 @@ TEST(BoundarySurface, LShapedPrismHasEightPatches) {
   const SurfacePatches p = boundary_surface_patches(s);
   ASSERT_EQ(p.patch_count(), 8);
   EXPECT_EQ(sorted_counts(p), (std::vector<int32_t>{4, 4, 4, 4, 8, 8, 12, 12}));
+}
+
+TEST(BoundarySurface, SteppedModelHasTenPatches) {
+  // Left, bottom, top, front and back (staircase outlines), 3 risers and 2 treads.
+  const HexMesh m = generate_stepped(SteppedParams{});
+  const HexTopology t = topology_build(m);
+  const BoundarySurface s = boundary_surface_build(m, t);
+  EXPECT_TRUE(surface_is_closed(s.surface));
+  EXPECT_EQ(euler_characteristic(s.surface), 2);
+  const SurfacePatches p = boundary_surface_patches(s);
+  ASSERT_EQ(p.patch_count(), 10);
+  EXPECT_EQ(sorted_counts(p), (std::vector<int32_t>{24, 24, 36, 36, 36, 99, 99, 108, 108, 156}));
 }
 
 TEST(BoundarySurface, CurvedSideStaysOnePatchBelowFeatureAngle) {

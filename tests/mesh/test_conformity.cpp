@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
+#include <random>
 
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
@@ -156,6 +158,40 @@ TEST(Conformity, NonPlanarReferenceOnlyReportsGeometryErrors) {
   EXPECT_EQ(r.non_conformal_faces, 3);  // the three faces at the moved corner leave the surface
 }
 
+TEST(Conformity, SlantedSplitOfWarpedHexStaysOnReference) {
+  // Reference: unit cube with corner 6 raised, so its +x, +y and +z faces are warped. Split it
+  // into two hexes by the parameter-space plane u = 0.3 + 0.4 v: the new nodes lie on the
+  // reference's straight edges, but the children's boundary faces are not parameter rectangles,
+  // so their centroids leave the warped patches by a fraction of the warp.
+  HexMesh reference = fixture_brick(1, 1, 1);
+  reference.points[7].z() = 1.4;  // brick ids run x fastest: node 7 is corner (1,1,1)
+  const std::array<Eigen::Vector3d, 8> r = hex_points(reference, 0);
+  auto map = [&](double u, double v, double w) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int c = 0; c < 8; ++c)
+      x += r[c] * ((hex_corner[c][0] ? u : 1 - u) * (hex_corner[c][1] ? v : 1 - v) *
+                   (hex_corner[c][2] ? w : 1 - w));
+    return x;
+  };
+  HexMesh m;
+  for (int w = 0; w <= 1; ++w)
+    for (int v = 0; v <= 1; ++v)
+      for (const double u : {0.0, 0.3 + 0.4 * v, 1.0}) m.points.push_back(map(u, v, w));
+  auto id = [](int i, int v, int w) { return static_cast<int32_t>(i + 3 * (v + 2 * w)); };
+  for (int i = 0; i < 2; ++i)
+    m.hexes.push_back({id(i, 0, 0), id(i + 1, 0, 0), id(i + 1, 1, 0), id(i, 1, 0), id(i, 0, 1),
+                       id(i + 1, 0, 1), id(i + 1, 1, 1), id(i, 1, 1)});
+  const MeshCheckReport report = mesh_check(m, &reference);
+  EXPECT_EQ(report.inverted_hexes, 0);
+  EXPECT_EQ(report.non_conformal_faces, 0);
+  EXPECT_TRUE(report.conformal);
+  EXPECT_FALSE(report.reference_planar_faced);
+  // The children's faces are new bilinear patches through points of the warped ones, so the
+  // volume changes (by 1.2%); for a warped reference that is reported, not a failure.
+  EXPECT_GT(report.volume_relative_error, 1e-3);
+  EXPECT_TRUE(report.geometry_preserved);
+}
+
 TEST(Conformity, FaceSharedByThreeHexes) {
   HexMesh m = fixture_brick(1, 1, 2);  // hexes 0 and 1 share the face z = 1, nodes {4, 5, 7, 6}
   for (int v = 4; v < 8; ++v) m.points.emplace_back(m.points[v] + Eigen::Vector3d(0.3, 0, 2));
@@ -193,6 +229,49 @@ TEST(Conformity, DuplicateAndUnusedNodes) {
   EXPECT_EQ(r.duplicate_nodes, 2);
   EXPECT_EQ(r.unused_nodes, 3);
   EXPECT_TRUE(r.conformal);  // loose nodes do not break conformity
+}
+
+TEST(Conformity, DuplicateNodesMatchBruteForce) {
+  // Random points, a structured grid (points on any cell walls the search might use) and
+  // near-copies within and beyond the tolerance; compared with the O(n^2) definition.
+  HexMesh m = fixture_brick(12, 12, 12, 0.25);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(0.0, 3.0), unit(-1.0, 1.0);
+  for (int i = 0; i < 1500; ++i)
+    m.points.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+  const double tolerance = mesh_check_duplicate_tolerance * std::sqrt(27.0);
+  const int32_t originals = m.point_count();
+  for (int i = 0; i < 600; ++i) {
+    const Eigen::Vector3d& p = m.points[random() % originals];
+    const Eigen::Vector3d offset(unit(random), unit(random), unit(random));
+    const double scale = (i % 3 == 0) ? 0.0 : (i % 3 == 1 ? 0.5 : 2.0) * tolerance;
+    m.points.push_back(p + scale * offset.normalized());
+  }
+  int64_t expected = 0;
+  for (int32_t i = 0; i < m.point_count(); ++i)
+    for (int32_t j = 0; j < i; ++j)
+      if ((m.points[i] - m.points[j]).norm() <= tolerance) {
+        ++expected;
+        break;
+      }
+  ASSERT_GT(expected, 350);
+  ASSERT_LT(expected, 600);
+  EXPECT_EQ(mesh_check(m).duplicate_nodes, expected);
+}
+
+TEST(Conformity, DuplicateNodesStraddlingASearchCellWall) {
+  // White-box: mirrors the cell size and origin of the duplicate search (mesh/conformity.cpp) to
+  // put a near pair on both sides of a cell wall in x and y.
+  HexMesh m;
+  for (int i = 0; i < 8; ++i) m.points.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  const double cell = 1.6180339887 / std::cbrt(10.0);
+  const double wall = -0.3819660113 * cell + cell;
+  const double tolerance = mesh_check_duplicate_tolerance * std::sqrt(3.0);
+  m.points.emplace_back(wall - 0.3 * tolerance, wall - 0.3 * tolerance, 0.5);
+  m.points.emplace_back(wall + 0.3 * tolerance, wall + 0.3 * tolerance, 0.5);
+  EXPECT_EQ(mesh_check(m).duplicate_nodes, 1);
+  m.points.back() = Eigen::Vector3d(wall + 0.8 * tolerance, wall + 0.8 * tolerance, 0.5);
+  EXPECT_EQ(mesh_check(m).duplicate_nodes, 0);  // 1.6 sqrt(2) x tolerance apart
 }
 
 TEST(Conformity, CrackOfDuplicatedNodesLeavesCoincidentFaces) {

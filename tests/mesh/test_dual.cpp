@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "mesh/generators.hpp"
 #include "mesh/hex_convention.hpp"
 #include "tests/fixtures.hpp"
 
@@ -211,6 +212,56 @@ TEST(Dual, PillowedCentreHexAddsClosedSheet) {
   EXPECT_EQ(closed_chords, 3);
   EXPECT_FALSE(d.chords[d.hex_chord[centre][0]].closed);
   EXPECT_EQ(d.chords[d.hex_chord[centre][0]].hex_count, 5);  // 2 brick + pillow + inner + pillow
+}
+
+TEST(Dual, GeneratedTwistedRing) {
+  // generate_twisted_ring documents: `around` slabs plus ceil(m / 2) self-intersecting sheets.
+  for (const int m : {1, 2, 3}) {
+    TwistedRingParams p;
+    p.section_intervals = m;
+    const HexMesh mesh = generate_twisted_ring(p);
+    const DualSheets d = dual_build(mesh, topology_build(mesh));
+    const int twisted = (m + 1) / 2;
+    ASSERT_EQ(d.sheet_count(), p.around + twisted) << "m = " << m;
+    int self = 0, slab_hexes = 0, twisted_hexes = 0;
+    for (const SheetInfo& s : d.sheets) {
+      EXPECT_FALSE(s.closed);
+      self += s.self_intersecting;
+      (s.self_intersecting ? twisted_hexes : slab_hexes) += s.hex_count;
+    }
+    EXPECT_EQ(self, twisted) << "m = " << m;
+    EXPECT_EQ(slab_hexes, mesh.hex_count());  // every hex in exactly one slab
+    EXPECT_GE(twisted_hexes, mesh.hex_count());
+  }
+}
+
+TEST(Dual, GeneratedCylinder) {
+  // O-grid: 2 n sheets across the square, m rings, one sheet per layer (generators.hpp).
+  CylinderParams p;
+  p.square_intervals = 3;  // sizes chosen so the three kinds of sheet have distinct hex counts
+  p.radial_intervals = 2;
+  p.layers = 2;
+  const HexMesh mesh = generate_cylinder(p);
+  const HexTopology t = topology_build(mesh);
+  const DualSheets d = dual_build(mesh, t);
+  ASSERT_EQ(d.sheet_count(), 2 * p.square_intervals + p.radial_intervals + p.layers);
+  const int n = p.square_intervals, m = p.radial_intervals;
+  const int section = n * n + 4 * n * m;
+  int layer_sheets = 0, ring_sheets = 0, across_sheets = 0;
+  for (const SheetInfo& s : d.sheets) {
+    EXPECT_FALSE(s.self_intersecting);
+    EXPECT_FALSE(s.closed);  // every sheet reaches the top, bottom or side
+    if (s.hex_count == section) {
+      ++layer_sheets;
+    } else if (s.hex_count == p.layers * 4 * n) {
+      ++ring_sheets;  // one ring of the outer blocks, through all layers
+    } else if (s.hex_count == p.layers * (n + 2 * m)) {
+      ++across_sheets;  // across the square and the two outer blocks it ends in
+    }
+  }
+  EXPECT_EQ(layer_sheets, p.layers);
+  EXPECT_EQ(ring_sheets, m);
+  EXPECT_EQ(across_sheets, 2 * n);
 }
 
 TEST(Dual, EmptyMesh) {

@@ -6,20 +6,20 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <numeric>
 #include <random>
 #include <vector>
 
+#include "mesh/conformity.hpp"
+#include "mesh/dual.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
+#include "mesh/selection.hpp"
 #include "mesh/topology.hpp"
 #include "tests/fixtures.hpp"
 
-#include "mesh/quality.hpp"
-
 namespace hexrefine {
 namespace {
-
 
 // Every boundary edge lies in exactly two boundary faces (a closed boundary surface); returns the
 // number of boundary edges.
@@ -39,36 +39,17 @@ int boundary_edges_closed(const HexTopology& t) {
   return edges;
 }
 
-// Private dual-sheet counter (union-find of each hex's four parallel edges); a sheet is
-// self-intersecting if one hex has two of its directions in it.
+// Sheet counts from mesh/dual.hpp.
 struct SheetCount {
   int sheets = 0;
   int self_intersecting = 0;
 };
 
 SheetCount sheets_count(const HexMesh& m, const HexTopology& t) {
-  std::vector<int32_t> parent(t.edge_count());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (int32_t h = 0; h < m.hex_count(); ++h)
-    for (int a = 0; a < 3; ++a)
-      for (int i = 1; i < 4; ++i)
-        parent[find(t.hex_edge_ids[h][hex_axis_edges[a][i]])] =
-            find(t.hex_edge_ids[h][hex_axis_edges[a][0]]);
+  const DualSheets d = dual_build(m, t);
   SheetCount out;
-  std::vector<uint8_t> self(t.edge_count(), 0);
-  for (int32_t e = 0; e < t.edge_count(); ++e) out.sheets += find(e) == e;
-  for (int32_t h = 0; h < m.hex_count(); ++h) {
-    int32_t root[3];
-    for (int a = 0; a < 3; ++a) root[a] = find(t.hex_edge_ids[h][hex_axis_edges[a][0]]);
-    for (int a = 0; a < 3; ++a)
-      for (int b = a + 1; b < 3; ++b)
-        if (root[a] == root[b]) self[root[a]] = 1;
-  }
-  for (uint8_t s : self) out.self_intersecting += s;
+  out.sheets = d.sheet_count();
+  for (const SheetInfo& s : d.sheets) out.self_intersecting += s.self_intersecting;
   return out;
 }
 
@@ -231,6 +212,9 @@ TEST(GenerateGear, DefaultIsTheThesisSizeWithBlocks) {
   ASSERT_NE(block, nullptr);
   EXPECT_EQ(std::count(block->begin(), block->end(), gear_block_body), 7 * 144 * 7);
   EXPECT_EQ(std::count(block->begin(), block->end(), gear_block_teeth), 7 * 24 * 9);
+  const Selection teeth = select_hexes(m, topology_build(m), {"block:2"});
+  EXPECT_EQ(teeth.hexes.size(), 7u * 24u * 9u);
+  for (int32_t h : teeth.hexes) EXPECT_EQ((*block)[h], gear_block_teeth);
   // Teeth lie outside the root circle, the body inside it.
   for (int32_t h = 0; h < m.hex_count(); ++h) {
     const Eigen::Vector3d c = hex_centroid(m, h);
@@ -443,6 +427,10 @@ TEST(GenerateStepped, TableSixOneModel) {
       riser_x.push_back(m.points[fn[0]].x());
   }
   EXPECT_EQ(riser_faces, 3 * 3 * 12);
+  // The refine command's selection picks the same hexes.
+  const Selection selected = select_hexes(m, t, {"boundary:1,0,0"});
+  ASSERT_EQ(selected.hexes.size(), static_cast<size_t>(riser_faces));
+  for (int32_t h : selected.hexes) EXPECT_TRUE(target[h]) << h;
   std::sort(riser_x.begin(), riser_x.end());
   EXPECT_EQ(riser_x, (std::vector<double>{9, 11, 13}));  // three surfaces make the right side
   for (int32_t h = 0; h < m.hex_count(); ++h)
@@ -499,6 +487,38 @@ TEST(GenerateStepped, CountsFollowParametersAndBadParameters) {
   bad = SteppedParams{};
   bad.cell = std::nan("");
   EXPECT_THROW(generate_stepped(bad), InputError);
+}
+
+// --- all --------------------------------------------------------------------------------
+
+TEST(Generators, DefaultsPassTheMeshCheck) {
+  BrickParams brick;
+  brick.dims = {5, 4, 3};
+  brick.jitter = 0.4;
+  const struct {
+    const char* name;
+    HexMesh mesh;
+    double volume;  ///< exact volume where the shape is a polyhedron; < 0 otherwise
+  } cases[] = {
+      {"brick", generate_brick(brick), 1.0},  // jitter keeps the boundary, hence the volume
+      {"gear", generate_gear(GearParams{}), -1.0},
+      {"cylinder", generate_cylinder(CylinderParams{}), -1.0},
+      {"twisted ring", generate_twisted_ring(TwistedRingParams{}), -1.0},
+      {"stepped", generate_stepped(SteppedParams{}), 1188.0},
+  };
+  for (const auto& c : cases) {
+    const MeshCheckReport r = mesh_check(c.mesh);
+    EXPECT_TRUE(r.valid()) << c.name;
+    EXPECT_TRUE(r.conformal) << c.name;
+    EXPECT_EQ(r.inverted_hexes, 0) << c.name;
+    EXPECT_EQ(r.duplicate_nodes, 0) << c.name;
+    EXPECT_EQ(r.unused_nodes, 0) << c.name;
+    EXPECT_EQ(r.nonmanifold_boundary_edges, 0) << c.name;
+    EXPECT_GT(r.volume, 0.0) << c.name;
+    if (c.volume > 0.0) {
+      EXPECT_NEAR(r.volume, c.volume, 1e-9 * c.volume) << c.name;
+    }
+  }
 }
 
 }  // namespace

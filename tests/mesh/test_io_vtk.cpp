@@ -106,6 +106,45 @@ TEST(IoVtu, RoundTripKeepsEverything) {
   for (const HexAttribute& a : m.attributes) io_expect_same_attribute(m, r, a.name);
 }
 
+TEST(IoVtu, ReadsVtkStyleAsciiWithInformationKeysAndRefusesBinary) {
+  // The layout vtkXMLUnstructuredGridWriter produces in ascii mode: empty PointData, CellData
+  // before Points, an InformationKey element inside the Points array.
+  const auto dir = test_temp_dir("io_vtu_vtk_style");
+  const std::string head =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
+      "<UnstructuredGrid>\n<Piece NumberOfPoints=\"8\" NumberOfCells=\"1\">\n<PointData>\n"
+      "<DataArray type=\"Float32\" Name=\"t\" format=\"ascii\">1 2 3 4 5 6 7 8</DataArray>\n"
+      "</PointData>\n<CellData>\n<DataArray type=\"Int32\" Name=\"block_id\" format=\"ascii\">\n"
+      "4\n</DataArray>\n</CellData>\n<Points>\n<DataArray type=\"Float64\" Name=\"Points\" "
+      "NumberOfComponents=\"3\" format=\"";
+  const std::string tail =
+      "\">\n0 0 0 1 0 0\n0 1 0 1 1 0\n0 0 1 1 0 1\n0 1 1 1 1 1\n"
+      "<InformationKey name=\"L2_NORM_RANGE\" location=\"vtkDataArray\" length=\"2\">\n"
+      "<Value index=\"0\">\n0\n</Value>\n</InformationKey>\n</DataArray>\n</Points>\n<Cells>\n"
+      "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n0 1 3 2 4 5\n7 6\n"
+      "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" "
+      "format=\"ascii\">\n8\n</DataArray>\n"
+      "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n12\n</DataArray>\n</Cells>\n"
+      "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  const auto p = dir / "vtk_style.vtu";
+  io_write_text(p, head + "ascii" + tail);
+  const HexMesh m = mesh_read(p.string());
+  ASSERT_EQ(m.hex_count(), 1);
+  EXPECT_EQ(m.hexes[0], (HexCell{0, 1, 3, 2, 4, 5, 7, 6}));
+  EXPECT_EQ(m.points[7], Eigen::Vector3d(1, 1, 1));
+  EXPECT_EQ(*mesh_find_attribute(m, attribute_block_id), std::vector<int32_t>{4});
+  const auto q = dir / "binary.vtu";
+  io_write_text(q, head + "binary" + tail);
+  try {
+    mesh_read(q.string());
+    FAIL() << "binary VTU accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("binary.vtu:14: DataArray 'Points' has format \"binary\""),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(IoFormat, ByExtension) {
   EXPECT_EQ(mesh_format_of("a/b.mesh"), MeshFormat::medit);
   EXPECT_EQ(mesh_format_of("b.VTK"), MeshFormat::vtk_legacy);
@@ -117,6 +156,15 @@ TEST(IoFormat, ByExtension) {
   EXPECT_THROW(mesh_format_of("b.stl"), InputError);
   EXPECT_THROW(mesh_format_of("dir.vtk/b"), InputError);
   EXPECT_THROW(mesh_read("/nonexistent/x.vtk"), InputError);
+  const auto dir = test_temp_dir("io_format_folder");
+  std::filesystem::create_directories(dir / "folder.mesh");
+  try {
+    mesh_read((dir / "folder.mesh").string());
+    ADD_FAILURE() << "folder accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("folder.mesh: is a folder"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "mesh/error.hpp"
+#include "mesh/generators.hpp"
 #include "tests/cli_runner.hpp"
 #include "tests/fixtures.hpp"
 
@@ -108,6 +109,27 @@ TEST_F(SelectionTest, BlockUsesBlockIdAttribute) {
   EXPECT_EQ(select({"block:2,7"}).hexes, (std::vector<int32_t>{3, 10, 11}));
   EXPECT_EQ(select({"block:0"}).hexes.size(), 21u);
   EXPECT_TRUE(select({"block:5"}).hexes.empty());
+}
+
+TEST(Selection, GearTeethByBlock) {
+  const GearParams p;
+  const HexMesh gear = generate_gear(p);
+  const HexTopology t = topology_build(gear);
+  const Selection teeth = select_hexes(gear, t, {"block:2"});
+  EXPECT_EQ(static_cast<int>(teeth.hexes.size()),
+            p.layers * p.teeth * p.tooth_tangential * p.tooth_radial);
+  EXPECT_EQ(select_hexes(gear, t, {"block:1,2"}).hexes.size(), gear.hexes.size());
+}
+
+TEST(Selection, SteppedRightSurfaceIsTheRisers) {
+  const SteppedParams p;
+  const HexMesh m = generate_stepped(p);
+  const HexTopology t = topology_build(m);
+  // Three risers, each step_layers x depth hexes; treads and the top face the +z direction.
+  EXPECT_EQ(static_cast<int>(select_hexes(m, t, {"boundary:1,0,0"}).hexes.size()),
+            p.steps * p.step_layers * p.depth);
+  EXPECT_EQ(static_cast<int>(select_hexes(m, t, {"boundary:0,0,1"}).hexes.size()),
+            (p.top_width + 2 * p.tread) * p.depth);
 }
 
 TEST_F(SelectionTest, EmptyResultIsAWarningNotAnError) {

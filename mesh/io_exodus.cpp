@@ -1,0 +1,255 @@
+/// \file
+/// Exodus II (.e, .exo) through libexodusii. HEX8 (and HEX/HEXAHEDRON with 8 nodes) has VTK's
+/// node order. Each element block is one block_id; blocks of other 3D elements (TETRA, WEDGE,
+/// PYRAMID, HEX20, HEX27, NFACED) are refused, blocks of shells, quads, triangles, bars and spheres
+/// are skipped. Exodus block ids must be positive: a block_id <= 0 is written under a fresh
+/// positive id (above every positive block_id) and the block is named "hexrefine_block_id=<v>";
+/// the reader takes block_id from such a name, else from the Exodus id. Coordinates are written as
+/// doubles (exact round trip). Hexes are written block by block with the element id map holding
+/// each hex's index + 1; the reader orders hexes by id when the ids of the hexes are a permutation
+/// of 1..n, so a written mesh reads back in its own order.
+
+#include <exodusII.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+
+#include "mesh/atomic_file.hpp"
+#include "mesh/io.hpp"
+#include "mesh/io_text.hpp"
+
+namespace hexrefine::io_detail {
+
+namespace {
+
+/// Closes the Exodus file on every path out.
+struct ExodusFile {
+  int id = -1;
+  ~ExodusFile() {
+    if (id >= 0) ex_close(id);
+  }
+};
+
+std::string upper(const char* s) {
+  std::string u(s);
+  for (char& c : u)
+    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 32);
+  return u;
+}
+
+}  // namespace
+
+HexMesh exodus_read(const std::string& path) {
+  // Check the netCDF signature ourselves first: the library must only ever see files that at
+  // least claim to be netCDF, and the size bounds the counts below.
+  int64_t file_size = 0;
+  bool hdf5 = false;
+  {
+    std::ifstream f(path, std::ios::binary | std::ios::ate);
+    if (!f) throw InputError(path + ": cannot open for reading (missing or not readable)");
+    file_size = static_cast<int64_t>(f.tellg());
+    char magic[4] = {0, 0, 0, 0};
+    f.seekg(0);
+    f.read(magic, 4);
+    const bool classic = magic[0] == 'C' && magic[1] == 'D' && magic[2] == 'F' &&
+                         (magic[3] == 1 || magic[3] == 2 || magic[3] == 5);
+    hdf5 = magic[0] == '\x89' && magic[1] == 'H' && magic[2] == 'D' && magic[3] == 'F';
+    if (!f || (!classic && !hdf5))
+      throw InputError(path +
+                       ": not an Exodus II file (expected a netCDF 'CDF' or HDF5 signature)");
+  }
+  ex_opts(EX_DEFAULT);  // report errors through return codes only; never abort
+  int comp_ws = 8, io_ws = 0;
+  float version = 0;
+  ExodusFile file;
+  file.id = ex_open(path.c_str(), EX_READ | EX_ALL_INT64_API, &comp_ws, &io_ws, &version);
+  if (file.id < 0)
+    throw InputError(path + ": cannot open as Exodus II (corrupt or truncated netCDF)");
+  char title[MAX_LINE_LENGTH + 1] = {0};
+  int64_t dim = 0, nodes = 0, elems = 0, blocks = 0, node_sets = 0, side_sets = 0;
+  if (ex_get_init(file.id, title, &dim, &nodes, &elems, &blocks, &node_sets, &side_sets) < 0)
+    throw InputError(path + ": cannot read the Exodus II header");
+  if (dim != 3)
+    throw InputError(path + ": Exodus II dimension " + std::to_string(dim) + ", expected 3");
+  // Classic files store every value: 4 bytes per coordinate and per connectivity entry at least.
+  // HDF5 files may be compressed, so they get a generous factor.
+  const int64_t budget = hdf5 ? file_size * 1000 : file_size;
+  if (nodes < 0 || elems < 0 || blocks < 0 || nodes > INT32_MAX || elems > INT32_MAX ||
+      nodes > budget / 12 || elems > budget / 4 || blocks > elems + 1)
+    throw InputError(path + ": Exodus II header claims " + std::to_string(nodes) + " nodes, " +
+                     std::to_string(elems) + " elements, " + std::to_string(blocks) +
+                     " blocks: more than the file (" + std::to_string(file_size) +
+                     " bytes) can hold");
+  HexMesh mesh;
+  {
+    std::vector<double> x(nodes), y(nodes), z(nodes);
+    if (nodes > 0 && ex_get_coord(file.id, x.data(), y.data(), z.data()) < 0)
+      throw InputError(path + ": cannot read the node coordinates");
+    mesh.points.resize(nodes);
+    for (int64_t i = 0; i < nodes; ++i) {
+      mesh.points[i] = Eigen::Vector3d(x[i], y[i], z[i]);
+      // netCDF returns its fill value for data missing from a truncated file.
+      if (!mesh.points[i].allFinite() || (mesh.points[i].array() == 9.9692099683868690e+36).any())
+        throw InputError(path + ": node " + std::to_string(i + 1) +
+                         " has a NaN, infinite or unwritten (netCDF fill) coordinate: corrupt or "
+                         "truncated file");
+    }
+  }
+  std::vector<int64_t> block_ids(blocks);
+  if (blocks > 0 && ex_get_ids(file.id, EX_ELEM_BLOCK, block_ids.data()) < 0)
+    throw InputError(path + ": cannot read the element block ids");
+  std::vector<int64_t> element_map(elems);
+  if (elems > 0 && ex_get_id_map(file.id, EX_ELEM_MAP, element_map.data()) < 0)
+    throw InputError(path + ": cannot read the element id map");
+  for (int64_t e = 0; e < elems; ++e)
+    if (element_map[e] < 1)
+      throw InputError(path + ": element " + std::to_string(e + 1) + " has id " +
+                       std::to_string(element_map[e]) +
+                       " in the element id map, expected >= 1 "
+                       "(corrupt or truncated file)");
+  std::vector<int64_t> hex_ids;
+  std::vector<int32_t> block;
+  int64_t first_element = 0;
+  for (int64_t b = 0; b < blocks; ++b) {
+    const int64_t bid = block_ids[b];
+    const std::string where = path + ": element block " + std::to_string(bid);
+    char type_name[MAX_STR_LENGTH + 1] = {0};
+    int64_t count = 0, per = 0, edges = 0, faces = 0, attrs = 0;
+    if (ex_get_block(file.id, EX_ELEM_BLOCK, bid, type_name, &count, &per, &edges, &faces, &attrs) <
+        0)
+      throw InputError(where + ": cannot read its parameters");
+    if (count < 0 || per < 0 || count > elems - first_element || per > 1000)
+      throw InputError(where + ": bad element count " + std::to_string(count) +
+                       " or nodes per element " + std::to_string(per));
+    const std::string type = upper(type_name);
+    const bool hex = type.rfind("HEX", 0) == 0 && per == 8;
+    const bool volume = type.rfind("HEX", 0) == 0 || type.rfind("TET", 0) == 0 ||
+                        type.rfind("WEDGE", 0) == 0 || type.rfind("PYRAMID", 0) == 0 ||
+                        type.rfind("NFACED", 0) == 0 || type.rfind("POLYHED", 0) == 0;
+    if (volume && !hex)
+      throw InputError(where + " has " + std::to_string(count) + " elements of type " + type +
+                       " with " + std::to_string(per) +
+                       " nodes: only linear hexahedra (HEX8) are supported");
+    if (hex && count > 0) {
+      int64_t block_id = bid;
+      char block_name[257] = {0};  // beyond any name length the library returns
+      if (ex_get_name(file.id, EX_ELEM_BLOCK, bid, block_name) >= 0) {
+        const std::string_view name(block_name);
+        const std::string_view prefix = "hexrefine_block_id=";
+        int64_t v = 0;
+        if (name.substr(0, prefix.size()) == prefix &&
+            TextCursor::parse_integer(name.substr(prefix.size()), v))
+          block_id = v;
+      }
+      if (block_id < INT32_MIN || block_id > INT32_MAX)
+        throw InputError(where + ": block id out of the int32 range");
+      std::vector<int64_t> conn(count * 8);
+      if (ex_get_conn(file.id, EX_ELEM_BLOCK, bid, conn.data(), nullptr, nullptr) < 0)
+        throw InputError(where + ": cannot read its connectivity");
+      for (int64_t e = 0; e < count; ++e) {
+        HexCell c;
+        for (int k = 0; k < 8; ++k) {
+          const int64_t v = conn[e * 8 + k];
+          if (v < 1 || v > nodes)
+            throw InputError(where + ", element " + std::to_string(e + 1) + ": node " +
+                             std::to_string(v) + " out of range 1.." + std::to_string(nodes));
+          c[k] = static_cast<int32_t>(v - 1);
+        }
+        mesh.hexes.push_back(c);
+        block.push_back(static_cast<int32_t>(block_id));
+        hex_ids.push_back(element_map[first_element + e]);
+      }
+    }
+    first_element += count;
+  }
+  // Restore the written order when the hex ids are exactly 1..m.
+  const size_t m = mesh.hexes.size();
+  std::vector<int32_t> slot(m);
+  bool permutation = true;
+  std::vector<char> seen(m, 0);
+  for (size_t i = 0; i < m && permutation; ++i) {
+    const int64_t t = hex_ids[i];
+    if (t < 1 || t > static_cast<int64_t>(m) || seen[t - 1])
+      permutation = false;
+    else
+      seen[t - 1] = 1, slot[i] = static_cast<int32_t>(t - 1);
+  }
+  if (permutation) {
+    std::vector<HexCell> hexes(m);
+    std::vector<int32_t> blocks_ordered(m);
+    for (size_t i = 0; i < m; ++i)
+      hexes[slot[i]] = mesh.hexes[i], blocks_ordered[slot[i]] = block[i];
+    mesh.hexes = std::move(hexes);
+    block = std::move(blocks_ordered);
+  }
+  mesh.attributes.push_back({std::string(attribute_block_id), std::move(block)});
+  mesh_check_read(mesh, path);
+  return mesh;
+}
+
+void exodus_write(const std::string& path, const HexMesh& mesh) {
+  const std::vector<int32_t>* block = mesh_find_attribute(mesh, attribute_block_id);
+  const size_t m = mesh.hexes.size(), n = mesh.points.size();
+  std::vector<std::pair<int32_t, int32_t>> order(m);
+  for (size_t h = 0; h < m; ++h) order[h] = {block ? (*block)[h] : 1, static_cast<int32_t>(h)};
+  std::sort(order.begin(), order.end());
+  std::vector<int64_t> blocks;
+  for (const auto& [b, h] : order)
+    if (blocks.empty() || blocks.back() != b) blocks.push_back(b);
+  // Exodus id of each block: the block_id itself when positive, else a fresh id above them all.
+  std::vector<int64_t> exodus_ids(blocks.size());
+  int64_t next_id = std::max<int64_t>(blocks.empty() ? 0 : blocks.back(), 0) + 1;
+  for (size_t b = 0; b < blocks.size(); ++b) exodus_ids[b] = blocks[b] > 0 ? blocks[b] : next_id++;
+
+  const std::string tmp = file_temporary_beside(path);
+  auto failed = [&](const std::string& what) {
+    std::remove(tmp.c_str());
+    throw OperationError(path + ": cannot write Exodus II file: " + what);
+  };
+  ex_opts(EX_DEFAULT);
+  {
+    int comp_ws = 8, io_ws = 8;
+    ExodusFile file;
+    file.id = ex_create(tmp.c_str(), EX_CLOBBER | EX_ALL_INT64_API, &comp_ws, &io_ws);
+    if (file.id < 0) failed("cannot create (folder missing or not writable)");
+    if (ex_put_init(file.id, "hexrefine mesh", 3, static_cast<int64_t>(n), static_cast<int64_t>(m),
+                    static_cast<int64_t>(blocks.size()), 0, 0) < 0)
+      failed("header");
+    std::vector<double> x(n), y(n), z(n);
+    for (size_t i = 0; i < n; ++i)
+      x[i] = mesh.points[i].x(), y[i] = mesh.points[i].y(), z[i] = mesh.points[i].z();
+    if (n > 0 && ex_put_coord(file.id, x.data(), y.data(), z.data()) < 0) failed("coordinates");
+    char cx[] = "x", cy[] = "y", cz[] = "z";
+    char* names[] = {cx, cy, cz};
+    if (ex_put_coord_names(file.id, names) < 0) failed("coordinate names");
+    size_t i = 0;
+    std::vector<int64_t> map(m);
+    for (size_t bi = 0; bi < blocks.size(); ++bi) {
+      const int64_t b = blocks[bi], eid = exodus_ids[bi];
+      const size_t first = i;
+      std::vector<int64_t> conn;
+      for (; i < m && order[i].first == b; ++i) {
+        for (int32_t v : mesh.hexes[order[i].second]) conn.push_back(v + 1);
+        map[i] = order[i].second + 1;
+      }
+      if (ex_put_block(file.id, EX_ELEM_BLOCK, eid, "HEX8", static_cast<int64_t>(i - first), 8, 0,
+                       0, 0) < 0)
+        failed("element block " + std::to_string(b));
+      if (ex_put_conn(file.id, EX_ELEM_BLOCK, eid, conn.data(), nullptr, nullptr) < 0)
+        failed("connectivity of element block " + std::to_string(b));
+      if (b <= 0) {
+        const std::string name = "hexrefine_block_id=" + std::to_string(b);
+        if (ex_put_name(file.id, EX_ELEM_BLOCK, eid, name.c_str()) < 0)
+          failed("name of element block " + std::to_string(b));
+      }
+    }
+    if (m > 0 && ex_put_id_map(file.id, EX_ELEM_MAP, map.data()) < 0) failed("element id map");
+    const int id = file.id;
+    file.id = -1;
+    if (ex_close(id) < 0) failed("close (disk full?)");
+  }
+  file_commit_temporary(tmp, path);
+}
+
+}  // namespace hexrefine::io_detail

@@ -1,0 +1,438 @@
+#include "experiments/runner.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "cli_runner.hpp"
+#include "experiments/cases.hpp"
+#include "mesh/error.hpp"
+
+namespace hexrefine {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+std::string file_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void file_put(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+}
+
+/// The message of the InputError `f` throws ("" if it throws nothing or something else).
+template <typename F>
+std::string input_error_of(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (...) {
+    return "(other exception)";
+  }
+  return "";
+}
+
+json brick_case(const std::string& name) {
+  return json{
+      {"name", name}, {"mesh", {{"generate", "brick"}, {"dims", {2, 2, 2}}}}, {"select", {"all"}}};
+}
+
+/// A plan of `n` cases "c0".."c{n-1}", both methods, built in memory.
+RunPlan fake_plan(int n, const std::string& output) {
+  json cases = json::array();
+  for (int i = 0; i < n; ++i) {
+    std::string name = "c";
+    name += std::to_string(i);  // (not "c" + to_string: GCC 12 -Wrestrict false positive)
+    cases.push_back(brick_case(name));
+  }
+  RunPlan plan = run_plan_parse(json{{"cases", cases}}, "mem.json", "/nonexistent");
+  plan.output = output;
+  return plan;
+}
+
+/// A fake method: "final_hexes" = 27 * (case index + 1) for selective, 100 + index for sheet.
+struct FakeExecutor {
+  int calls = 0;
+  std::vector<std::string> ran;  ///< "case:method" in order
+  void operator()(const RunCase& c, const std::vector<std::string>& methods, const RunEmit& emit) {
+    ++calls;
+    for (const std::string& m : methods) {
+      ran.push_back(c.name + ":" + m);
+      emit(m, json{{"final_hexes", m == "selective" ? 27 * (c.index + 1) : 100 + c.index}});
+    }
+  }
+};
+
+RunSettings quiet_settings() {
+  RunSettings s;
+  s.quiet = true;
+  s.environment.commit = "abc123";
+  s.environment.cpu = "test cpu";
+  s.environment.cores = 2;
+  s.environment.build_type = "release";
+  return s;
+}
+
+TEST(Sha256, KnownDigests) {
+  EXPECT_EQ(sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  // 56 bytes: the padding spills into a second block.
+  EXPECT_EQ(sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  EXPECT_EQ(sha256_hex(std::string(1000000, 'a')),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+TEST(Sha256, OfFileMatchesOfBytes) {
+  const auto dir = test_temp_dir("runner_sha_file");
+  file_put(dir / "m.txt", "abc");
+  EXPECT_EQ(sha256_file((dir / "m.txt").string()), sha256_hex("abc"));
+  EXPECT_NE(input_error_of([&] { sha256_file((dir / "missing.txt").string()); }), "");
+}
+
+TEST(RunPlan, ParsesDefaultsAndResolvesRelativePaths) {
+  const auto dir = test_temp_dir("runner_parse");
+  file_put(dir / "m.mesh", "x");
+  const json root = {{"cases",
+                      {brick_case("a"),
+                       {{"name", "b"},
+                        {"mesh", {{"file", "m.mesh"}}},
+                        {"select", {"sphere:0,0,0,1", "hexes:sel.txt"}},
+                        {"methods", {"sheet"}},
+                        {"passes", 3},
+                        {"smooth", true},
+                        {"options", {{"buffer", true}, {"ranking", false}}},
+                        {"tags", {{"table", "X"}}}}}},
+                     {"output", "out/r.jsonl"}};
+  const RunPlan plan = run_plan_parse(root, "cases.json", dir.string());
+  ASSERT_EQ(plan.cases.size(), 2u);
+  const RunCase& a = plan.cases[0];
+  EXPECT_EQ(a.methods, (std::vector<std::string>{"selective", "sheet"}));
+  EXPECT_EQ(a.options.passes, 1);
+  EXPECT_TRUE(a.options.ranking);
+  EXPECT_FALSE(a.smooth);
+  const RunCase& b = plan.cases[1];
+  EXPECT_EQ(b.index, 1);
+  EXPECT_EQ(b.mesh["file"], "m.mesh");
+  EXPECT_EQ(b.mesh["path"], (dir / "m.mesh").string());
+  EXPECT_EQ(b.select[1], "hexes:" + (dir / "sel.txt").string());
+  EXPECT_EQ(b.select_given[1], "hexes:sel.txt");
+  EXPECT_EQ(b.options.passes, 3);
+  EXPECT_TRUE(b.options.buffer);
+  EXPECT_FALSE(b.options.ranking);
+  EXPECT_TRUE(b.smooth);
+  EXPECT_EQ(b.tags["table"], "X");
+  EXPECT_EQ(plan.output, (dir / "out" / "r.jsonl").string());
+  // Without "output": beside the case file, named after it.
+  const RunPlan p2 = run_plan_parse(json{{"cases", {brick_case("a")}}}, "sweep.json", "/d");
+  EXPECT_EQ(p2.output, "/d/sweep.jsonl");
+}
+
+TEST(RunPlan, SchemaErrorsNameFileAndJsonPath) {
+  auto error_of = [](const json& root) {
+    return input_error_of([&] { run_plan_parse(root, "cases.json", "/nonexistent"); });
+  };
+  EXPECT_EQ(error_of(json::array()), "cases.json: /: expected an object");
+  EXPECT_EQ(error_of(json{{"output", "x"}}), "cases.json: /: missing \"cases\"");
+  EXPECT_EQ(error_of(json{{"cases", json::array()}}),
+            "cases.json: /cases: expected a non-empty array");
+  json c = brick_case("a");
+  c["passes"] = 0;
+  EXPECT_EQ(error_of(json{{"cases", {brick_case("z"), c}}}),
+            "cases.json: /cases/1/passes: expected an integer >= 1");
+  c = brick_case("a");
+  c["methods"] = {"selective", "octree"};
+  EXPECT_EQ(error_of(json{{"cases", {c}}}),
+            "cases.json: /cases/0/methods/1: unknown method 'octree' (expected selective or "
+            "sheet)");
+  c = brick_case("a");
+  c["mesh"]["dims"] = {2, 0, 2};
+  EXPECT_EQ(error_of(json{{"cases", {c}}}),
+            "cases.json: /cases/0/mesh/dims/1: expected an integer >= 1");
+  c = brick_case("a");
+  c["mesh"]["radius"] = 1.0;
+  EXPECT_NE(error_of(json{{"cases", {c}}})
+                .find("/cases/0/mesh/radius: unknown parameter of "
+                      "generator 'brick'"),
+            std::string::npos);
+  c = brick_case("a");
+  c["optoins"] = json::object();
+  EXPECT_NE(error_of(json{{"cases", {c}}}).find("cases.json: /cases/0/optoins: unknown key"),
+            std::string::npos);
+  c = brick_case("a");
+  c["options"] = {{"ranking", 1}};
+  EXPECT_EQ(error_of(json{{"cases", {c}}}),
+            "cases.json: /cases/0/options/ranking: expected true or false");
+  c = brick_case("a");
+  c["mesh"] = {{"file", "nowhere.mesh"}};
+  EXPECT_EQ(error_of(json{{"cases", {c}}}),
+            "cases.json: /cases/0/mesh/file: mesh file not found: /nonexistent/nowhere.mesh");
+  c = brick_case("a");
+  c["mesh"] = {{"file", "x.mesh"}, {"generate", "brick"}};
+  EXPECT_EQ(error_of(json{{"cases", {c}}}),
+            "cases.json: /cases/0/mesh: expected exactly one of \"generate\" or \"file\"");
+  c = brick_case("a");
+  c.erase("select");
+  EXPECT_NE(error_of(json{{"cases", {c}}}).find("/cases/0: missing \"select\""), std::string::npos);
+  EXPECT_EQ(error_of(json{{"cases", {brick_case("a"), brick_case("a")}}}),
+            "cases.json: /cases/1/name: case name 'a' used twice");
+}
+
+TEST(RunPlan, ReadReportsSyntaxErrorLine) {
+  const auto dir = test_temp_dir("runner_read");
+  file_put(dir / "bad.json", "{\"cases\": [\n  {\"name\": \"a\",\n   \"mesh\": }\n]}\n");
+  const std::string e = input_error_of([&] { run_plan_read((dir / "bad.json").string()); });
+  EXPECT_EQ(e.rfind((dir / "bad.json").string() + ":3: invalid JSON", 0), 0u) << e;
+  EXPECT_NE(input_error_of([&] { run_plan_read((dir / "none.json").string()); }), "");
+}
+
+TEST(RunRecordKey, OptionsAreCanonical) {
+  RefineOptions defaults;
+  RefineOptions same;
+  same.ranking = true;
+  EXPECT_EQ(run_record_key("G-1", "selective", run_options_to_json(defaults, false)),
+            run_record_key("G-1", "selective", run_options_to_json(same, false)));
+  RefineOptions other;
+  other.ranking = false;
+  EXPECT_NE(run_record_key("G-1", "selective", run_options_to_json(defaults, false)),
+            run_record_key("G-1", "selective", run_options_to_json(other, false)));
+  EXPECT_NE(run_record_key("G-1", "selective", run_options_to_json(defaults, false)),
+            run_record_key("G-1", "selective", run_options_to_json(defaults, true)));
+  EXPECT_EQ(run_options_to_json(defaults, false).size(), 7u);
+}
+
+TEST(Jsonl, AppendsAndReadsBack) {
+  const auto dir = test_temp_dir("runner_jsonl");
+  const std::string path = (dir / "r.jsonl").string();
+  EXPECT_TRUE(jsonl_read(path).records.empty());  // missing file: no records
+  for (int i = 0; i < 3; ++i)
+    jsonl_append(path, json{{"case", "c" + std::to_string(i)},
+                            {"method", "sheet"},
+                            {"options", json::object()},
+                            {"value", i}});
+  const JsonlContent c = jsonl_read(path);
+  ASSERT_EQ(c.records.size(), 3u);
+  EXPECT_EQ(c.records[2]["value"], 2);
+  EXPECT_FALSE(c.truncated_tail);
+  EXPECT_EQ(c.valid_text, file_text(path));
+  EXPECT_EQ(std::count(c.valid_text.begin(), c.valid_text.end(), '\n'), 3);
+}
+
+TEST(Jsonl, DropsTruncatedLastLineOnly) {
+  const auto dir = test_temp_dir("runner_jsonl_trunc");
+  const std::string path = (dir / "r.jsonl").string();
+  const std::string good = "{\"case\":\"a\",\"method\":\"sheet\",\"options\":{}}\n";
+  file_put(path, good + "{\"case\":\"b\",\"meth");
+  JsonlContent c = jsonl_read(path);
+  EXPECT_EQ(c.records.size(), 1u);
+  EXPECT_TRUE(c.truncated_tail);
+  EXPECT_EQ(c.valid_text, good);
+  // A complete record without its final newline is also treated as cut short.
+  file_put(path, good + good.substr(0, good.size() - 1));
+  c = jsonl_read(path);
+  EXPECT_EQ(c.records.size(), 1u);
+  EXPECT_TRUE(c.truncated_tail);
+  // A bad line in the middle is bad input, named by line.
+  file_put(path, good + "garbage\n" + good);
+  EXPECT_EQ(input_error_of([&] { jsonl_read(path); }), path + ":2: not a JSON record");
+  file_put(path, good + "{\"case\":\"a\"}\n");
+  EXPECT_EQ(input_error_of([&] { jsonl_read(path); }).rfind(path + ":2: record without", 0), 0u);
+}
+
+TEST(RunPlanExecute, WritesOneRecordPerCaseAndMethod) {
+  const auto dir = test_temp_dir("runner_execute");
+  const std::string out = (dir / "r.jsonl").string();
+  const RunPlan plan = fake_plan(3, out);
+  FakeExecutor fake;
+  const RunSummary s = run_plan_execute(plan, quiet_settings(), std::ref(fake));
+  EXPECT_EQ(s.records_written, 6);
+  EXPECT_EQ(s.records_skipped, 0);
+  EXPECT_EQ(s.errors, 0);
+  EXPECT_EQ(fake.calls, 3);
+  const auto records = jsonl_read(out).records;
+  ASSERT_EQ(records.size(), 6u);
+  EXPECT_EQ(records[0]["case"], "c0");
+  EXPECT_EQ(records[0]["method"], "selective");
+  EXPECT_EQ(records[1]["method"], "sheet");
+  EXPECT_EQ(records[1]["method_index"], 1);
+  EXPECT_EQ(records[4]["case_index"], 2);
+  EXPECT_EQ(records[4]["final_hexes"], 81);
+  EXPECT_EQ(records[5]["final_hexes"], 102);
+  EXPECT_EQ(records[0]["commit"], "abc123");
+  EXPECT_EQ(records[0]["machine"]["cpu"], "test cpu");
+  EXPECT_EQ(records[0]["machine"]["cores"], 2);
+  EXPECT_EQ(records[0]["build_type"], "release");
+  EXPECT_EQ(records[0]["options"]["passes"], 1);
+  EXPECT_EQ(records[0]["timestamp"].get<std::string>().size(), 20u);
+  // A second run without --resume starts the file over.
+  run_plan_execute(plan, quiet_settings(), std::ref(fake));
+  EXPECT_EQ(jsonl_read(out).records.size(), 6u);
+}
+
+TEST(RunPlanExecute, ResumeAfterKilledRunLosesNothingAndRepeatsNothing) {
+  const auto dir = test_temp_dir("runner_resume");
+  const std::string out = (dir / "r.jsonl").string();
+  const RunPlan plan = fake_plan(4, out);
+  FakeExecutor first;
+  run_plan_execute(plan, quiet_settings(), std::ref(first));
+  // Simulate a run killed while writing its 6th record: 5 whole lines and half of the 6th.
+  std::string text = file_text(out);
+  size_t pos = 0;
+  for (int i = 0; i < 5; ++i) pos = text.find('\n', pos) + 1;
+  const size_t sixth_end = text.find('\n', pos);
+  file_put(out, text.substr(0, pos + (sixth_end - pos) / 2));
+
+  RunSettings settings = quiet_settings();
+  settings.resume = true;
+  FakeExecutor second;
+  const RunSummary s = run_plan_execute(plan, settings, std::ref(second));
+  EXPECT_EQ(s.records_skipped, 5);
+  EXPECT_EQ(s.records_written, 3);
+  // c2's selective record survived; its sheet record (cut short) and c3's two are redone.
+  EXPECT_EQ(second.ran, (std::vector<std::string>{"c2:sheet", "c3:selective", "c3:sheet"}));
+  const auto records = jsonl_read(out);
+  EXPECT_FALSE(records.truncated_tail);
+  ASSERT_EQ(records.records.size(), 8u);
+  std::set<std::string> keys;
+  for (const json& r : records.records) keys.insert(run_record_key(r));
+  EXPECT_EQ(keys.size(), 8u);
+  // Resuming a finished run does nothing.
+  FakeExecutor third;
+  const RunSummary s3 = run_plan_execute(plan, settings, std::ref(third));
+  EXPECT_EQ(s3.records_skipped, 8);
+  EXPECT_EQ(s3.records_written, 0);
+  EXPECT_EQ(third.calls, 0);
+}
+
+TEST(RunPlanExecute, ErrorsBecomeRecordsAndTheRunGoesOn) {
+  const auto dir = test_temp_dir("runner_errors");
+  const std::string out = (dir / "r.jsonl").string();
+  const RunPlan plan = fake_plan(3, out);
+  auto executor = [](const RunCase& c, const std::vector<std::string>& methods,
+                     const RunEmit& emit) {
+    if (c.index == 0) throw OperationError("mesh could not be built");
+    for (const std::string& m : methods) {
+      if (c.index == 1 && m == "sheet") throw InputError("bad spec 'boxx:1'");
+      emit(m, json{{"final_hexes", 1}});
+    }
+  };
+  const RunSummary s = run_plan_execute(plan, quiet_settings(), executor);
+  EXPECT_EQ(s.records_written, 6);
+  EXPECT_EQ(s.errors, 3);
+  const auto records = jsonl_read(out).records;
+  ASSERT_EQ(records.size(), 6u);
+  EXPECT_EQ(records[0]["error"], "mesh could not be built");
+  EXPECT_EQ(records[0]["error_kind"], "operation");
+  EXPECT_EQ(records[1]["error"], "mesh could not be built");
+  EXPECT_FALSE(records[2].contains("error"));
+  EXPECT_EQ(records[3]["error"], "bad spec 'boxx:1'");
+  EXPECT_EQ(records[3]["error_kind"], "input");
+  EXPECT_EQ(records[5]["final_hexes"], 1);
+}
+
+TEST(RunShard, ParsesOneBasedAndRefusesNonsense) {
+  EXPECT_EQ(run_shard_parse("1/4"), (std::pair<int, int>{0, 4}));
+  EXPECT_EQ(run_shard_parse("4/4"), (std::pair<int, int>{3, 4}));
+  for (const char* bad : {"0/4", "5/4", "1/0", "a/4", "1-4", "1/", "/4", "-1/4", "1/4/2"})
+    EXPECT_NE(input_error_of([&] { run_shard_parse(bad); }), "") << bad;
+  EXPECT_EQ(run_shard_output("/r/thesis.jsonl", 1, 3), "/r/thesis.shard-2-of-3.jsonl");
+  EXPECT_EQ(run_shard_output("/r/thesis.jsonl", 0, 1), "/r/thesis.jsonl");
+}
+
+TEST(RunShard, ShardsPartitionTheCasesAndMergeRestoresTheOrder) {
+  const auto dir = test_temp_dir("runner_shards");
+  const std::string out = (dir / "r.jsonl").string();
+  const RunPlan plan = fake_plan(7, out);
+  std::vector<std::vector<json>> parts;
+  std::multiset<std::string> cases_run;
+  for (int k = 0; k < 3; ++k) {
+    RunSettings settings = quiet_settings();
+    settings.shard = k;
+    settings.shard_count = 3;
+    FakeExecutor fake;
+    const RunSummary s = run_plan_execute(plan, settings, std::ref(fake));
+    EXPECT_EQ(s.output, run_shard_output(out, k, 3));
+    parts.push_back(jsonl_read(s.output).records);
+    for (const json& r : parts.back()) cases_run.insert(r["case"].get<std::string>());
+    for (const json& r : parts.back()) EXPECT_EQ(r["case_index"].get<int>() % 3, k);
+  }
+  EXPECT_EQ(parts[0].size(), 6u);  // cases 0, 3, 6
+  EXPECT_EQ(parts[1].size(), 4u);  // cases 1, 4
+  EXPECT_EQ(parts[2].size(), 4u);  // cases 2, 5
+  EXPECT_EQ(cases_run.size(), 14u);
+  for (int i = 0; i < 7; ++i) EXPECT_EQ(cases_run.count("c" + std::to_string(i)), 2u);
+
+  // Merge in the wrong order, with a duplicate: case order restored, one record per key.
+  std::vector<std::vector<json>> inputs = {parts[2], parts[0], parts[1], {parts[0][2]}};
+  inputs.back()[0]["final_hexes"] = -7;  // a rerun of c3:selective supersedes the first
+  const std::vector<json> merged = run_records_merge(inputs);
+  ASSERT_EQ(merged.size(), 14u);
+  for (size_t i = 0; i < merged.size(); ++i) {
+    EXPECT_EQ(merged[i]["case_index"], static_cast<int>(i / 2));
+    EXPECT_EQ(merged[i]["method_index"], static_cast<int>(i % 2));
+  }
+  EXPECT_EQ(merged[6]["case"], "c3");
+  EXPECT_EQ(merged[6]["final_hexes"], -7);
+  jsonl_write((dir / "merged.jsonl").string(), merged);
+  EXPECT_EQ(jsonl_read((dir / "merged.jsonl").string()).records, merged);
+}
+
+TEST(ScaledJacobianHistogram, FixedBins) {
+  const std::vector<int64_t> h =
+      scaled_jacobian_histogram({1.0, 0.95, 0.3077, 0.0, -0.05, -1.0, -3.0, 2.0});
+  ASSERT_EQ(h.size(), 20u);
+  EXPECT_EQ(h[19], 3);  // 1.0, 0.95 and 2.0 (clamped)
+  EXPECT_EQ(h[13], 1);  // 0.3077 in [0.3, 0.4)
+  EXPECT_EQ(h[10], 1);  // 0.0 in [0, 0.1)
+  EXPECT_EQ(h[9], 1);   // -0.05 in [-0.1, 0)
+  EXPECT_EQ(h[0], 2);   // -1.0 and -3.0 (clamped)
+  int64_t total = 0;
+  for (int64_t v : h) total += v;
+  EXPECT_EQ(total, 8);
+}
+
+TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
+  const std::string meshes = std::string(HEXREFINE_SHARED_DIR) + "/meshes";
+  for (const bool quick : {true, false}) {
+    const json root = thesis_suite_cases(quick, meshes, "thesis.jsonl");
+    const RunPlan plan = run_plan_parse(root, "suite.json", "/");
+    const size_t sweep = quick ? 6 : 15;  // n = 5..30 or 5..75
+    // G-1, 6-1, 6-2, H-1, H-2 (two), H-3, H-4, real, 6 ablations, two sweeps.
+    EXPECT_EQ(plan.cases.size(), 15u + 2 * sweep);
+    int g2 = 0, ablations = 0;
+    for (const RunCase& c : plan.cases) {
+      if (c.tags.value("table", "") == "G-2") {
+        ++g2;
+        EXPECT_EQ(c.select, std::vector<std::string>{"all"});
+      }
+      if (c.tags.value("table", "") == "ablation") {
+        ++ablations;
+        EXPECT_EQ(c.methods, std::vector<std::string>{"selective"});
+      } else {
+        EXPECT_EQ(c.methods, (std::vector<std::string>{"selective", "sheet"})) << c.name;
+      }
+    }
+    EXPECT_EQ(g2, static_cast<int>(sweep));
+    EXPECT_EQ(ablations, 6);
+    EXPECT_EQ(plan.cases[0].name, "G-1");
+    EXPECT_EQ(plan.cases[0].mesh["dims"], json({10, 10, 10}));
+    EXPECT_EQ(plan.cases[0].select,
+              (std::vector<std::string>{"boundary:-1,0,0", "boundary:0,0,-1"}));
+    EXPECT_EQ(plan.cases.back().name, quick ? "G-3/n=30" : "G-3/n=75");
+    EXPECT_EQ(plan.output, "/thesis.jsonl");
+  }
+  EXPECT_EQ(thesis_sweep_intervals(true), (std::vector<int>{5, 10, 15, 20, 25, 30}));
+}
+
+}  // namespace
+}  // namespace hexrefine

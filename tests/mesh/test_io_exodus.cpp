@@ -1,0 +1,71 @@
+#include <gtest/gtest.h>
+
+#include "cli_runner.hpp"
+#include "io_test_support.hpp"
+#include "mesh/error.hpp"
+#include "mesh/io.hpp"
+
+namespace hexrefine {
+namespace {
+
+TEST(IoExodus, RoundTripIsExactAndKeepsBlocksAndOrder) {
+  const auto dir = test_temp_dir("io_exodus_roundtrip");
+  const HexMesh m = io_test_brick();
+  const std::string path = (dir / "brick.e").string();
+  mesh_write(path, m);
+  const HexMesh r = mesh_read(path);
+  io_expect_same_geometry(m, r, 0);
+  io_expect_same_attribute(m, r, attribute_block_id);
+  EXPECT_EQ(mesh_find_attribute(r, attribute_template_tag), nullptr);
+}
+
+TEST(IoExodus, NonPositiveBlockIdsSurviveThroughBlockNames) {
+  const auto dir = test_temp_dir("io_exodus_negative");
+  HexMesh m = io_test_brick();
+  mesh_attribute(m, attribute_block_id)[0] = -1;  // EX_INVALID_ID as an Exodus id
+  mesh_attribute(m, attribute_block_id)[4] = 0;
+  const std::string path = (dir / "neg.e").string();
+  mesh_write(path, m);
+  const HexMesh r = mesh_read(path);
+  io_expect_same_geometry(m, r, 0);
+  io_expect_same_attribute(m, r, attribute_block_id);
+}
+
+TEST(IoExodus, MeshWithoutBlocksIsBlockOne) {
+  const auto dir = test_temp_dir("io_exodus_noblock");
+  const HexMesh m = fixture_brick(2, 1, 1);
+  const std::string path = (dir / "b.exo").string();
+  mesh_write(path, m);
+  const HexMesh r = mesh_read(path);
+  io_expect_same_geometry(m, r, 0);
+  EXPECT_EQ(*mesh_find_attribute(r, attribute_block_id), std::vector<int32_t>(2, 1));
+}
+
+TEST(IoExodus, ReadsSculptSphere) {
+  const HexMesh m = mesh_read(shared_mesh("sphere_sculpt.e"));
+  EXPECT_EQ(m.hex_count(), 80);  // as counted by meshio
+  EXPECT_EQ(m.point_count(), 149);
+}
+
+TEST(IoExodus, RefusesNonNetcdfAndTruncatedFiles) {
+  const auto dir = test_temp_dir("io_exodus_bad");
+  io_write_text(dir / "text.e", "this is not netcdf\n");
+  EXPECT_THROW(mesh_read((dir / "text.e").string()), InputError);
+  const std::string good = (dir / "good.e").string();
+  mesh_write(good, io_test_brick());
+  std::ifstream in(good, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (size_t cut : {size_t{4}, size_t{100}, bytes.size() / 2, bytes.size() - 8}) {
+    const auto p = dir / ("cut" + std::to_string(cut) + ".e");
+    io_write_text(p, bytes.substr(0, cut));
+    try {
+      mesh_read(p.string());
+      ADD_FAILURE() << "truncated file accepted at " << cut;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hexrefine

@@ -456,6 +456,18 @@ TEST(SelectiveResults, DISABLED_WriteResults) {
       o.ebe_only = true;
       record("L-shaped, --ebe-only", m, t, o);
     }
+    {
+      // Table H-2: 4x4x4 brick, left surface refined three times.
+      const HexMesh m = fixture_brick(4, 4, 4);
+      std::vector<int32_t> left;
+      for (int32_t h = 0; h < m.hex_count(); ++h)
+        if (h % 4 == 0) left.push_back(h);
+      RefineOptions o;
+      o.passes = 3;
+      record("4x4x4 left surface, 3 passes (Table H-2)", m, left, o);
+      o.buffer = true;
+      record("4x4x4 left surface, 3 passes, --buffer (Table H-2)", m, left, o);
+    }
     for (int n : {5, 10, 15, 20, 25, 30}) {
       BrickParams bp;
       bp.dims = {n, n, n};

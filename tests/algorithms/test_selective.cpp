@@ -38,6 +38,46 @@ TEST(Selective, SharedRefinerSuite) {
   EXPECT_EQ(sizes[4], 55272);  // gear teeth (thesis H-1: 63,093 on its own gear)
 }
 
+TEST(Selective, ElementByElementAdjustmentsAreConformal) {
+  // Hex (1,1,1) of a 3x3x3 brick meets three targets along three x-edges only: 1-3 with one
+  // adjustment at its fourth x-edge, whose two neighbours (1-13 each) share the merged face.
+  const HexMesh m = fixture_brick(3, 3, 3);
+  auto id = [](int i, int j, int k) { return fixture_brick_hex(3, 3, i, j, k); };
+  RefineResult r;
+  {
+    r = selective_refine(m, {{id(1, 0, 0), id(1, 2, 0), id(1, 0, 2)}}, {});
+    const MeshCheckReport c = mesh_check(r.mesh, &m);
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(c.doublets, 0);
+    EXPECT_EQ(r.stats.hexes_per_template.at("1-3-adj1"), 3);
+    EXPECT_EQ(r.stats.doublets_resolved, 0);
+  }
+  {
+    // Two diagonally opposite x-edges: 1-3 with two adjustments.
+    r = selective_refine(m, {{id(1, 0, 0), id(1, 2, 2)}}, {});
+    const MeshCheckReport c = mesh_check(r.mesh, &m);
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(c.doublets, 0);
+    EXPECT_EQ(r.stats.hexes_per_template.at("1-3-adj2"), 3);
+  }
+  {
+    // Appendix F: in the radial case at interval 5 three adjustments would sit on boundary
+    // edges (three faces): those edges are split first and no adjusted template is used there.
+    BrickParams bp;
+    bp.dims = {5, 5, 5};
+    const HexMesh b = generate_brick(bp);
+    std::vector<int32_t> t;
+    for (int32_t h = 0; h < b.hex_count(); ++h)
+      if ((hex_centroid(b, h) - Eigen::Vector3d(1, 1, 1)).norm() <= 0.5) t.push_back(h);
+    r = selective_refine(b, {t}, {});
+    const MeshCheckReport c = mesh_check(r.mesh, &b);
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(c.doublets, 0);
+    EXPECT_EQ(r.stats.doublets_resolved, 3);
+    EXPECT_EQ(r.stats.hexes_per_template.count("1-3-adj1"), 0u);
+  }
+}
+
 TEST(Selective, FullRefinementOfBricks) {
   for (int n : {1, 2, 3, 5}) {
     const HexMesh m = fixture_brick(n, n, n);
@@ -415,6 +455,18 @@ TEST(SelectiveResults, DISABLED_WriteResults) {
       o = {};
       o.ebe_only = true;
       record("L-shaped, --ebe-only", m, t, o);
+    }
+    {
+      // Table H-2: 4x4x4 brick, left surface refined three times.
+      const HexMesh m = fixture_brick(4, 4, 4);
+      std::vector<int32_t> left;
+      for (int32_t h = 0; h < m.hex_count(); ++h)
+        if (h % 4 == 0) left.push_back(h);
+      RefineOptions o;
+      o.passes = 3;
+      record("4x4x4 left surface, 3 passes (Table H-2)", m, left, o);
+      o.buffer = true;
+      record("4x4x4 left surface, 3 passes, --buffer (Table H-2)", m, left, o);
     }
     for (int n : {5, 10, 15, 20, 25, 30}) {
       BrickParams bp;

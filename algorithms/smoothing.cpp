@@ -493,6 +493,9 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
     throw InputError("mesh_smooth: feature angle must be in (0, 180) degrees, got " +
                      std::to_string(options.feature_angle_degrees));
   mesh_validate_ids(mesh, "mesh_smooth");
+  for (int32_t n = 0; n < mesh.point_count(); ++n)
+    if (!mesh.points[n].allFinite())
+      throw InputError("mesh_smooth: node " + std::to_string(n) + " has a non-finite coordinate");
   for (int32_t h : options.region_hexes)
     if (h < 0 || h >= mesh.hex_count())
       throw InputError("mesh_smooth: region hex " + std::to_string(h) + " out of range 0.." +

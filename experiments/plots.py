@@ -28,6 +28,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 SINGLE_TABLES = ["G-1", "6-1", "6-2", "H-1", "H-2", "H-3", "H-4"]
 SWEEPS = ["G-2", "G-3"]
 METHODS = ["sheet", "selective"]  # the thesis' column order
+METHOD_COLOURS = {"selective": "tab:blue", "sheet": "tab:red"}
 
 
 def fail(message):
@@ -231,7 +232,7 @@ def sweep_table(name, thesis, records, out, exponents):
 def sweep_plot(name, thesis, series, path):
     t = thesis.get(name, {})
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
-    colours = {"selective": "tab:blue", "sheet": "tab:red"}
+    colours = METHOD_COLOURS
     ours_max = max([s[1] for m in METHODS for s in series[m] if s[2] is not None and s[1]],
                    default=None)
     for ax, log in zip(axes, (False, True)):
@@ -274,6 +275,7 @@ def quality_plot(groups, path):
     for ax, case in zip(axes.flat, names):
         ax.set_visible(True)
         width = None
+        lowest = 0.0
         for offset, m in ((-0.5, "selective"), (0.5, "sheet")):
             r = next((x for _, x in cases if x["case"] == case and x["method"] == m), None)
             if not r:
@@ -282,9 +284,11 @@ def quality_plot(groups, path):
             width = h["bin_width"]
             lefts = [h["bin_edges_from"] + i * width for i in range(len(h["counts"]))]
             ax.bar([x + width / 2 + offset * width * 0.4 for x in lefts], h["counts"],
-                   width=width * 0.4, label=m, log=True)
+                   width=width * 0.4, label=m, log=True, color=METHOD_COLOURS[m])
+            used = [x for x, c in zip(lefts, h["counts"]) if c > 0]
+            lowest = min([lowest] + used[:1]) if used else lowest
         ax.set_title(case, fontsize=9)
-        ax.set_xlim(-0.1 if width else -1, 1.05)
+        ax.set_xlim(lowest - 0.1, 1.05)  # inverted hexes (negative bins) stay in view
         ax.set_xlabel("scaled Jacobian")
         ax.legend(fontsize=7)
     fig.tight_layout()
@@ -300,15 +304,20 @@ def ablation_table(records, groups, out):
     out.append("| base case | variant | final hexes | directional hexes | doublets resolved | "
                "time (s) | min scaled Jacobian | check |")
     out.append("|---|---|---:|---:|---:|---:|---:|---|")
+    bases = []
     for r in rows:
-        tags = r.get("tags", {})
-        base = record_of(records, tags.get("base"), "selective")
-        for variant, x in (("baseline", base), (tags.get("variant"), r)):
-            if variant == "baseline" and (x is None or tags.get("variant") != "no-ranking"):
-                continue  # the baseline row once per base case
+        base = r.get("tags", {}).get("base")
+        if base not in bases:
+            bases.append(base)
+    for base in bases:
+        # The unablated run first (the base case's own selective record), then each variant.
+        lines = [("baseline", record_of(records, base, "selective"))]
+        lines += [(r.get("tags", {}).get("variant"), r) for r in rows
+                  if r.get("tags", {}).get("base") == base]
+        for variant, x in lines:
             ok = x is not None and "error" not in x
             out.append("| %s | %s | %s | %s | %s | %s | %s | %s |" % (
-                tags.get("base"), variant, fmt(x.get("final_hexes") if ok else None),
+                base, variant, fmt(x.get("final_hexes") if ok else None),
                 fmt(x.get("directional_hexes") if ok else None),
                 fmt(x.get("doublets_resolved") if ok else None),
                 fmt(x.get("time_seconds") if ok else None),

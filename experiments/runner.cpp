@@ -183,9 +183,9 @@ json parse_mesh(const json& j, const SchemaPath& p, const std::string& base_dir)
 
 RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_dir, int index) {
   schema_require_object(j, p);
-  schema_allow_keys(
-      j, p,
-      {"name", "description", "mesh", "select", "methods", "passes", "smooth", "options", "tags"});
+  schema_allow_keys(j, p,
+                    {"name", "description", "mesh", "select", "methods", "passes", "smooth",
+                     "save_mesh", "options", "tags"});
   RunCase c;
   c.index = index;
   if (!j.contains("name")) p.fail("missing \"name\"");

@@ -306,6 +306,9 @@ TEST(Smoothing, BadOptionsAreInputErrors) {
   o.feature_angle_degrees = 180;
   EXPECT_THROW(mesh_smooth(m, o), InputError);
   o = {};
+  m.points[13].y() = std::nan("");
+  EXPECT_THROW(mesh_smooth(m, o), InputError);
+  m.points[13].y() = 1;
   m.hexes[0][0] = 99;
   EXPECT_THROW(mesh_smooth(m, o), InputError);
 }

@@ -532,6 +532,18 @@ RunEnvironment run_environment_detect() {
         env.commit = text;
     }
   }
+  if (env.commit != "unknown") {
+    // Results must say whether they came from exactly that commit.
+    const std::string status =
+        "git -C '" + run_source_dir() + "' status --porcelain --untracked-files=no 2>/dev/null";
+    if (FILE* pipe = ::popen(status.c_str(), "r")) {
+      std::array<char, 64> buf{};
+      env.commit_dirty = fread(buf.data(), 1, buf.size(), pipe) > 0;
+      while (fread(buf.data(), 1, buf.size(), pipe) > 0) {
+      }
+      ::pclose(pipe);
+    }
+  }
   std::ifstream cpuinfo("/proc/cpuinfo");
   std::string line;
   while (std::getline(cpuinfo, line)) {
@@ -668,6 +680,7 @@ RunSummary run_plan_execute(const RunPlan& plan, const RunSettings& settings,
       record["options"] = options;
       record["tags"] = c.tags;
       record["commit"] = settings.environment.commit;
+      record["commit_dirty"] = settings.environment.commit_dirty;
       record["machine"] = {{"cpu", settings.environment.cpu},
                            {"cores", settings.environment.cores}};
       record["build_type"] = settings.environment.build_type;

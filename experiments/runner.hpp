@@ -119,6 +119,7 @@ std::string sha256_file(const std::string& path);
 /// Facts stamped on every record.
 struct RunEnvironment {
   std::string commit = "unknown";  ///< `git rev-parse HEAD` in the source dir
+  bool commit_dirty = false;       ///< tracked files differ from that commit
   std::string cpu = "unknown";     ///< "model name" of /proc/cpuinfo
   int cores = 0;                   ///< std::thread::hardware_concurrency()
   std::string build_type;          ///< "release" (NDEBUG) or "debug"

@@ -58,6 +58,21 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+// Corner-Jacobian inversion test of an input hex.
+bool hex_is_inverted(const HexMesh& m, int32_t h) {
+  const auto x = hex_points(m, h);
+  for (int v = 0; v < 8; ++v) {
+    std::array<Eigen::Vector3d, 3> e;
+    for (int k = 0; k < 3; ++k) {
+      const int edge = hex_vertex_edges[v][k];
+      const int w = hex_edges[edge][0] == v ? hex_edges[edge][1] : hex_edges[edge][0];
+      e[k] = hex_corner[v][k] ? (x[v] - x[w]) : (x[w] - x[v]);
+    }
+    if (!(e[0].dot(e[1].cross(e[2])) > 0)) return true;
+  }
+  return false;
+}
+
 enum Role : uint8_t { kUntouched = 0, kTarget = 1, kElement = 2, kDirectional = 3 };
 
 // Local edges an element-by-element template or a directional step would adjust at, for a hex
@@ -123,18 +138,19 @@ std::vector<NewEdge> template_new_edges(const HexTemplate& t) {
   std::vector<NewEdge> out;
   std::vector<std::pair<int16_t, int16_t>> seen;
   auto extreme = [](double x) { return std::abs(x) < 1e-12 || std::abs(x - 1) < 1e-12; };
-  for (const auto& c : t.children) {
+  for (size_t ci = 0; ci < t.children.size(); ++ci) {
+    const auto& c = t.children[ci];
     for (int e = 0; e < 12; ++e) {
       int16_t a = c[hex_edges[e][0]], b = c[hex_edges[e][1]];
       if (a > b) std::swap(a, b);
       if (std::find(seen.begin(), seen.end(), std::make_pair(a, b)) != seen.end()) continue;
       seen.emplace_back(a, b);
+      // The sheet class of this edge (not its geometric direction).
+      const int axis = t.child_axis[ci][hex_edge_axis[e]];
       const auto& ra = t.nodes[a].ref;
       const auto& rb = t.nodes[b].ref;
       int shared = 0, face = -1;
-      int axis = 0;
       for (int k = 0; k < 3; ++k) {
-        if (std::abs(rb[k] - ra[k]) > std::abs(rb[axis] - ra[axis])) axis = k;
         const bool on = t.nodes[a].adjustment_edge < 0 && t.nodes[b].adjustment_edge < 0 &&
                         extreme(ra[k]) && std::abs(ra[k] - rb[k]) < 1e-12;
         if (on) {
@@ -142,7 +158,9 @@ std::vector<NewEdge> template_new_edges(const HexTemplate& t) {
           face = 2 * k + (ra[k] > 0.5 ? 1 : 0);
         }
       }
-      if (shared >= 2 || axis == 0) continue;  // a piece of a cell edge, or parallel to x
+      // A piece of a cell edge, parallel to the refined x, or on a sheet closed inside.
+      if (shared >= 2 || axis <= 0) continue;
+      if (face >= 0 && face / 2 == axis) face = -1;
       out.push_back({a, b, static_cast<int8_t>(axis), static_cast<int8_t>(face)});
     }
   }
@@ -580,8 +598,8 @@ bool SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
             }
           if (valence < 4) {
             // Appendix F inside the hex: split the edge and choose this rank's templates again.
-            if (split_segments_.insert(segment_key(c.key[hex_edges[le][0]],
-                                                   c.key[hex_edges[le][1]]))
+            if (split_segments_
+                    .insert(segment_key(c.key[hex_edges[le][0]], c.key[hex_edges[le][1]]))
                     .second)
               ++stats_.doublets_resolved;
             return true;
@@ -600,11 +618,6 @@ bool SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
 
 void SelectivePass::apply(const Decision& d, std::vector<TemplateCell>& next) {
   const TemplateCell& c = cells_[d.di][d.cell];
-  if (std::getenv("SELDBG") && c.hex == std::atoi(std::getenv("SELDBG"))) {
-    fprintf(stderr, "apply %s sym %d axis %d%d%d cell", template_tag_name(d.choice.tmpl->tag), d.choice.symmetry, c.axis[0], c.axis[1], c.axis[2]);
-    for (int k = 0; k < 8; ++k) fprintf(stderr, " %d(%.3f %.3f %.3f)", c.nodes[k], c.param[k][0] / double(template_param_unit), c.param[k][1] / double(template_param_unit), c.param[k][2] / double(template_param_unit));
-    fprintf(stderr, "\n");
-  }
   std::vector<TemplateNodeKey> keys;
   refiner_->apply(c, *d.choice.tmpl, d.choice.symmetry, next, &keys);
   if (!options_.propagation) return;
@@ -628,7 +641,6 @@ void SelectivePass::refine_directional() {
   std::vector<TemplateCell> next;
   std::vector<uint8_t> replaced;
   for (const auto& round : rounds_) {
-    if (std::getenv("SELDBG")) { fprintf(stderr, "round:"); for (const auto& [di, d] : round) fprintf(stderr, " %d/%d", directional_[di], d); fprintf(stderr, "\n"); }
     for (bool again = true; again;) {
       again = false;
       decisions.clear();
@@ -663,7 +675,8 @@ void SelectivePass::refine_directional() {
           const auto [it, inserted] = round_alias.emplace(p.from, Owner{p.to, &c, p.edge});
           if (inserted || it->second.to == p.to) continue;
           if (!split_inside(c, p.edge) && !split_inside(*it->second.cell, it->second.edge)) {
-            for (const auto& [cc, ee] : {std::pair{&c, p.edge}, {it->second.cell, it->second.edge}}) {
+            for (const auto& [cc, ee] :
+                 {std::pair{&c, p.edge}, {it->second.cell, it->second.edge}}) {
               const int32_t ie = cell_edge_input_edge(*cc, ee);
               if (ie >= 0) throw InputEdgeSplitNeeded{ie};
             }
@@ -702,28 +715,65 @@ void SelectivePass::check_output(const PassOutput& out) const {
   // open by non-matching subdivisions shows up as a boundary face inside the mesh), and no
   // output hex from a valid input hex is inverted (corner Jacobians).
   const HexTopology t = topology_build(out.mesh);
-  std::vector<int32_t> bad_parents;
+  std::vector<int32_t> bad_parents, inverted_parents;
   for (int32_t f : t.nonmanifold_faces) bad_parents.push_back(out.parent[t.face_hexes[f][0]]);
   const int32_t n_in = mesh_.point_count();
-  std::vector<uint8_t> on_boundary(out.mesh.point_count(), 0);
-  for (int32_t f : topology_boundary_faces(topo_))
-    for (int32_t n : topo_.face_nodes[f]) on_boundary[n] = 1;
+  // A boundary face of the output must lie on one boundary face of the input: every node is
+  // an input node of that face, a node keyed on one of its edges, or a node keyed on it.
   const auto& keys = refiner_->created_keys();
-  for (size_t i = 0; i < keys.size(); ++i) {
-    const TemplateNodeKey& k = keys[i];
-    const int64_t id = k.entity & 0xFFFFFFFFFF;
-    if (k.kind() == TemplateNodeKey::edge)
-      on_boundary[n_in + i] = edge_is_boundary(topo_, static_cast<int32_t>(id));
-    else if (k.kind() == TemplateNodeKey::face)
-      on_boundary[n_in + i] = face_is_boundary(topo_, static_cast<int32_t>(id));
-  }
+  auto key_of = [&](int32_t n) -> const TemplateNodeKey* {
+    return n >= n_in ? &keys[n - n_in] : nullptr;
+  };
+  auto node_on_face = [&](int32_t n, int32_t f) {
+    const auto& fn = topo_.face_nodes[f];
+    auto has = [&](int32_t x) { return std::find(fn.begin(), fn.end(), x) != fn.end(); };
+    const TemplateNodeKey* k = key_of(n);
+    if (!k) return has(n);
+    const int32_t id = static_cast<int32_t>(k->entity & 0xFFFFFFFFFF);
+    if (k->kind() == TemplateNodeKey::face) return id == f;
+    if (k->kind() == TemplateNodeKey::edge)
+      return has(topo_.edge_nodes[id][0]) && has(topo_.edge_nodes[id][1]);
+    return false;
+  };
+  std::vector<int32_t> candidates;
   for (int32_t f : topology_boundary_faces(t)) {
-    bool ok = true;
-    for (int32_t n : t.face_nodes[f]) ok = ok && on_boundary[n];
+    const auto& q = t.face_nodes[f];
+    candidates.clear();
+    int32_t anchor = q[0];
+    for (int32_t n : q) {
+      const TemplateNodeKey* k = key_of(n);
+      if (k && k->kind() == TemplateNodeKey::face) anchor = n;
+    }
+    const TemplateNodeKey* k = key_of(anchor);
+    if (k && k->kind() == TemplateNodeKey::face) {
+      candidates.push_back(static_cast<int32_t>(k->entity & 0xFFFFFFFFFF));
+    } else {
+      // Boundary faces of the input hexes around an input node of this face, or around the
+      // edge a keyed node sits on.
+      int32_t around = -1;
+      for (int32_t n : q)
+        if (n < n_in) around = n;
+      if (around < 0 && k && k->kind() == TemplateNodeKey::edge)
+        around = topo_.edge_nodes[k->entity & 0xFFFFFFFFFF][0];
+      if (around >= 0)
+        for (int32_t h : node_hexes(topo_, around))
+          for (int32_t g : topo_.hex_face_ids[h])
+            if (face_is_boundary(topo_, g)) candidates.push_back(g);
+    }
+    bool ok = false;
+    for (int32_t g : candidates) {
+      bool all = face_is_boundary(topo_, g);
+      for (int32_t n : q) all = all && node_on_face(n, g);
+      if (all) {
+        ok = true;
+        break;
+      }
+    }
     if (!ok) bad_parents.push_back(out.parent[t.face_hexes[f][0]]);
   }
   for (int32_t h = 0; h < out.mesh.hex_count(); ++h) {
     if (out.role[out.parent[h]] == kUntouched) continue;
+    if (options_.allow_inverted && hex_is_inverted(mesh_, out.parent[h])) continue;
     const auto x = hex_points(out.mesh, h);
     for (int v = 0; v < 8; ++v) {
       const Eigen::Vector3d a = x[hex_edges[hex_vertex_edges[v][0]][hex_corner[v][0] ? 0 : 1]];
@@ -733,20 +783,27 @@ void SelectivePass::check_output(const PassOutput& out) const {
                    sc = hex_corner[v][2] ? -1 : 1;
       const double det = (sa * (a - x[v])).dot((sb * (b - x[v])).cross(sc * (c - x[v])));
       if (!(det > 0)) {
-        bad_parents.push_back(out.parent[h]);
+        inverted_parents.push_back(out.parent[h]);
         break;
       }
     }
   }
-  if (bad_parents.empty()) return;
-  std::sort(bad_parents.begin(), bad_parents.end());
-  bad_parents.erase(std::unique(bad_parents.begin(), bad_parents.end()), bad_parents.end());
-  std::string list;
-  for (size_t i = 0; i < bad_parents.size() && i < 20; ++i)
-    list += (i ? ", " : "") + std::to_string(bad_parents[i]);
-  if (bad_parents.size() > 20) list += ", ...";
-  throw OperationError("selective_refine: cannot refine this configuration conformally; " +
-                       std::to_string(bad_parents.size()) + " input hexes affected: " + list);
+  auto listed = [](std::vector<int32_t>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    std::string list = std::to_string(v.size()) + " input hexes affected: ";
+    for (size_t i = 0; i < v.size() && i < 20; ++i) list += (i ? ", " : "") + std::to_string(v[i]);
+    if (v.size() > 20) list += ", ...";
+    return list;
+  };
+  if (!bad_parents.empty())
+    throw OperationError("selective_refine: cannot refine this configuration conformally; " +
+                         listed(bad_parents));
+  if (!inverted_parents.empty())
+    throw OperationError(
+        "selective_refine: the templates would invert hexes here (the input "
+        "hexes are too distorted for them); " +
+        listed(inverted_parents));
 }
 
 PassOutput SelectivePass::run() {
@@ -830,23 +887,8 @@ PassOutput SelectivePass::run() {
   mesh_attribute(res, attribute_refinement_level, 0) = std::move(level);
   stats_.phase_seconds["assembly"] += seconds_since(t4);
 
-  if (options_.ranking && options_.propagation && !options_.ebe_only && !std::getenv("SELDBG")) check_output(out);
+  if (options_.ranking && options_.propagation && !options_.ebe_only) check_output(out);
   return out;
-}
-
-// Corner-Jacobian inversion test of an input hex.
-bool hex_is_inverted(const HexMesh& m, int32_t h) {
-  const auto x = hex_points(m, h);
-  for (int v = 0; v < 8; ++v) {
-    std::array<Eigen::Vector3d, 3> e;
-    for (int k = 0; k < 3; ++k) {
-      const int edge = hex_vertex_edges[v][k];
-      const int w = hex_edges[edge][0] == v ? hex_edges[edge][1] : hex_edges[edge][0];
-      e[k] = hex_corner[v][k] ? (x[v] - x[w]) : (x[w] - x[v]);
-    }
-    if (!(e[0].dot(e[1].cross(e[2])) > 0)) return true;
-  }
-  return false;
 }
 
 }  // namespace

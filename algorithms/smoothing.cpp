@@ -388,7 +388,7 @@ class Smoother {
       if (!(gradient.norm() > 1e-12 / scale)) return;
       const Vec3 direction = gradient.normalized();
       bool moved = false;
-      for (; step > 1e-7 * scale; step *= 0.5) {
+      for (int halving = 0; halving < 10; ++halving, step *= 0.5) {
         const Vec3 candidate = node_constrain(n, x + step * direction);
         double candidate_min;
         if (node_trial(n, candidate, candidate_min) && candidate_min > local_min + 1e-12) {

@@ -146,7 +146,10 @@ class TemplateBuilder {
     child({a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]});
   }
 
-  HexTemplate take() { return std::move(t_); }
+  HexTemplate take() {
+    template_compute_child_axes(t_);
+    return std::move(t_);
+  }
 
  private:
   HexTemplate t_;
@@ -438,19 +441,18 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
       out.exact = out.exact && pl.exact;
       out.collapsed = out.collapsed || pl.aliased;
     }
-    // Local axes of the child in the cell's frame (sum of its four parallel edges), then in the
-    // input hex's frame.
+    // Local axes of the child: the template's sheet classes (canonical axes), mapped by the
+    // symmetry to the cell's axes, then to the input hex's. A reflection swaps the child's
+    // local x and y (the re-ordering above).
+    const size_t ci = static_cast<size_t>(&child - t.children.data());
     for (int k = 0; k < 3; ++k) {
-      std::array<double, 3> d = {0, 0, 0};
-      for (int e : hex_axis_edges[k]) {
-        const auto pa = cube_symmetry_apply(s, t.nodes[c[hex_edges[e][0]]].ref);
-        const auto pb = cube_symmetry_apply(s, t.nodes[c[hex_edges[e][1]]].ref);
-        for (int m = 0; m < 3; ++m) d[m] += pb[m] - pa[m];
-      }
-      int best = 0;
-      for (int m = 1; m < 3; ++m)
-        if (std::abs(d[m]) > std::abs(d[best])) best = m;
-      out.axis[k] = cell.axis[best];
+      const int kt = s.reflection ? (k == 0 ? 1 : k == 1 ? 0 : 2) : k;
+      const int cls = t.child_axis.empty() ? -1 : t.child_axis[ci][kt];
+      int8_t mapped = -1;
+      if (cls >= 0)
+        for (int m = 0; m < 3; ++m)
+          if (s.axis[m] == cls) mapped = cell.axis[m];
+      out.axis[k] = mapped;
     }
     children.push_back(out);
   }
@@ -521,6 +523,66 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
   return out;
 }
 
+void template_compute_child_axes(HexTemplate& t) {
+  const int nc = static_cast<int>(t.children.size());
+  std::vector<int> parent(3 * nc);
+  for (int i = 0; i < 3 * nc; ++i) parent[i] = i;
+  auto find = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  auto local_edge = [&](int c, int16_t a, int16_t b) {
+    for (int e = 0; e < 12; ++e) {
+      const int16_t x = t.children[c][hex_edges[e][0]], y = t.children[c][hex_edges[e][1]];
+      if ((x == a && y == b) || (x == b && y == a)) return e;
+    }
+    return -1;
+  };
+  // Children sharing a face: each edge of the face joins the two children's directions.
+  std::vector<std::pair<std::array<int16_t, 4>, std::pair<int, int>>> faces;
+  for (int c = 0; c < nc; ++c)
+    for (int f = 0; f < 6; ++f) {
+      std::array<int16_t, 4> q;
+      for (int i = 0; i < 4; ++i) q[i] = t.children[c][hex_faces[f][i]];
+      std::sort(q.begin(), q.end());
+      faces.push_back({q, {c, f}});
+    }
+  std::sort(faces.begin(), faces.end());
+  for (size_t i = 0; i + 1 < faces.size(); ++i) {
+    if (faces[i].first != faces[i + 1].first) continue;
+    const int ca = faces[i].second.first, fa = faces[i].second.second;
+    const int cb = faces[i + 1].second.first;
+    for (int k = 0; k < 4; ++k) {
+      const int le = hex_face_edges[fa][k];
+      const int16_t a = t.children[ca][hex_edges[le][0]], b = t.children[ca][hex_edges[le][1]];
+      const int lb = local_edge(cb, a, b);
+      if (lb < 0) continue;
+      parent[find(3 * ca + hex_edge_axis[le])] = find(3 * cb + hex_edge_axis[lb]);
+    }
+  }
+  // Seeds: a child edge on a cube edge belongs to that edge's axis.
+  std::vector<int8_t> root_class(3 * nc, -1);
+  for (int c = 0; c < nc; ++c)
+    for (int e = 0; e < 12; ++e) {
+      const TemplateNode& na = t.nodes[t.children[c][hex_edges[e][0]]];
+      const TemplateNode& nb = t.nodes[t.children[c][hex_edges[e][1]]];
+      if (na.adjustment_edge >= 0 || nb.adjustment_edge >= 0) continue;
+      int fixed = 0, free_axis = -1;
+      for (int k = 0; k < 3; ++k) {
+        if (is_extreme(na.ref[k]) && std::abs(na.ref[k] - nb.ref[k]) < 1e-12)
+          ++fixed;
+        else
+          free_axis = k;
+      }
+      if (fixed != 2) continue;
+      int8_t& rc = root_class[find(3 * c + hex_edge_axis[e])];
+      if (rc < 0) rc = static_cast<int8_t>(free_axis);
+    }
+  t.child_axis.assign(nc, {-1, -1, -1});
+  for (int c = 0; c < nc; ++c)
+    for (int k = 0; k < 3; ++k) t.child_axis[c][k] = root_class[find(3 * c + k)];
+}
+
 const HexTemplate& template_1_27() {
   static const HexTemplate t = [] {
     HexTemplate r;
@@ -535,6 +597,7 @@ const HexTemplate& template_1_27() {
           r.children.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
                                 id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
                                 id(i, j + 1, k + 1)});
+    template_compute_child_axes(r);
     return r;
   }();
   return t;
@@ -552,6 +615,7 @@ const HexTemplate& template_1_3() {
     for (int i = 0; i < 3; ++i)
       r.children.push_back({id(i, 0, 0), id(i + 1, 0, 0), id(i + 1, 1, 0), id(i, 1, 0), id(i, 0, 1),
                             id(i + 1, 0, 1), id(i + 1, 1, 1), id(i, 1, 1)});
+    template_compute_child_axes(r);
     return r;
   }();
   return t;

@@ -49,7 +49,17 @@ struct HexTemplate {
   TemplateTag tag = TemplateTag::untouched;
   std::vector<TemplateNode> nodes;
   std::vector<std::array<int16_t, 8>> children;
+  /// Per child and local axis: the canonical axis of the parent's sheet that this direction of
+  /// the child belongs to (sheets followed through the children's shared faces, seeded by the
+  /// pieces of the cube's edges), -1 for a sheet closed inside the template. Topological, not
+  /// geometric: in 1-4 the top child's "y" edges (Q1 D, Q2 C) lie on the sheet that turns
+  /// round from the split x-edge, so that direction belongs to x. Filled by
+  /// template_compute_child_axes.
+  std::vector<std::array<int8_t, 3>> child_axis;
 };
+
+/// Fills tmpl.child_axis.
+void template_compute_child_axes(HexTemplate& tmpl);
 
 /// One of the 48 symmetries of the cube: reference point p maps to
 /// q[k] = flip[k] ? 1 - p[axis[k]] : p[axis[k]].
@@ -135,7 +145,8 @@ struct TemplateCell {
   HexCell nodes{};
   std::array<TemplateParam, 8> param{};
   std::array<TemplateNodeKey, 8> key{};
-  /// Local axis k of this cell runs along axis axis[k] of the input hex.
+  /// Local axis k of this cell belongs to the sheet of axis axis[k] of the input hex (-1: a sheet
+  /// closed inside a template, never refined again).
   std::array<int8_t, 3> axis = {0, 1, 2};
   bool whole = true;       ///< the input hex itself
   bool exact = true;       ///< every corner's param is exact (else it cannot be refined further)

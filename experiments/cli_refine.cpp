@@ -100,7 +100,7 @@ int cli_refine(const std::vector<std::string>& args) {
   }
 
   const MeshCheckReport check = mesh_check(result.mesh, &input);
-  if (!ablation && !options.allow_inverted && !check.valid() && !std::getenv("SELDBG")) {
+  if (!ablation && !options.allow_inverted && !check.valid()) {
     std::string why;
     for (const std::string& d : mesh_check_defects(check)) why += "\n  " + d;
     throw OperationError("hexrefine refine: the " + method +

@@ -50,7 +50,7 @@ if target:
     lines += [
         "",
         f"Target topology_build for 1,000,000 hexes <= 1 s: {verdict} "
-        f"({target['real_time']:.0f} ms).",
+        f"(median wall {target['real_time']:.0f} ms, CPU {target['cpu_time']:.0f} ms).",
         "Where wall time exceeds CPU time the process was not on a CPU "
         "for the difference: the 2 CPUs were shared with other builds, so the CPU column is the "
         "better measure of the code.",

@@ -5,13 +5,21 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <random>
+#include <sstream>
+#include <tuple>
 
+#include "algorithms/templates.hpp"
 #include "mesh/conformity.hpp"
+#include "mesh/dual.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"
+#include "mesh/io.hpp"
 #include "tests/algorithms/refiner_suite.hpp"
+#include "tests/cli_runner.hpp"
 #include "tests/fixtures.hpp"
 
 namespace hexrefine {
@@ -21,6 +29,13 @@ std::vector<int32_t> all_hexes(const HexMesh& m) {
   std::vector<int32_t> t(m.hex_count());
   for (int32_t h = 0; h < m.hex_count(); ++h) t[h] = h;
   return t;
+}
+
+TEST(Selective, SharedRefinerSuite) {
+  const std::vector<int64_t> sizes = refiner_suite_run(selective_refine);
+  ASSERT_EQ(sizes.size(), 6u);
+  EXPECT_EQ(sizes[2], 8060);   // L-shaped
+  EXPECT_EQ(sizes[4], 55272);  // gear teeth (thesis H-1: 63,093 on its own gear)
 }
 
 TEST(Selective, FullRefinementOfBricks) {
@@ -144,11 +159,13 @@ TEST(SelectiveRandom, TargetSetsOnJitteredBricks) {
         ++refused;
         // The reason, without the hex ids.
         std::string w = e.what();
-        w.erase(std::remove_if(w.begin(), w.end(), [](char c) { return std::isdigit(c) || c == ','; }),
-                w.end());
+        w.erase(
+            std::remove_if(w.begin(), w.end(), [](char c) { return std::isdigit(c) || c == ','; }),
+            w.end());
         ++refusals[w.substr(0, 90)];
-        if (t.size() <= 7 && n == 4) {
-          std::printf("n %d seed %d kind %d:", n, int(seed * 7919 + n), int((seed * 7919 + n) % 6));
+        {
+          std::printf("refused: n %d seed %d kind %d:", n, int(seed * 7919 + n),
+                      int((seed * 7919 + n) % 6));
           for (int32_t x : t) std::printf(" %d", x);
           std::printf("\n");
         }
@@ -157,6 +174,350 @@ TEST(SelectiveRandom, TargetSetsOnJitteredBricks) {
   }
   std::printf("refined %d refused %d empty %d\n", refined, refused, empty);
   for (const auto& [k, v] : refusals) std::printf("  %d x %s\n", v, k.c_str());
+  // results/selective_random.md: 2,000 sets, 3 empty, 1,991 refined (all valid), 6 refused.
+  EXPECT_EQ(refined + refused + empty, 2000);
+  EXPECT_GE(refined, 1991);
+  EXPECT_LE(refused, 6);
+}
+
+}  // namespace
+}  // namespace hexrefine
+
+namespace hexrefine {
+namespace {
+
+// Refines and checks with both the project's checker (against the input) and the suite's
+// topological check; returns the checker's report.
+MeshCheckReport refine_and_check(const HexMesh& m, const std::vector<int32_t>& targets,
+                                 RefineResult* out = nullptr, const RefineOptions& o = {}) {
+  RefineResult r = selective_refine(m, {targets}, o);
+  const MeshCheckReport c = mesh_check(r.mesh, &m);
+  if (out) *out = std::move(r);
+  return c;
+}
+
+std::vector<int32_t> hexes_within(const HexMesh& m, const Eigen::Vector3d& c, double radius) {
+  std::vector<int32_t> t;
+  for (int32_t h = 0; h < m.hex_count(); ++h)
+    if ((hex_centroid(m, h) - c).norm() <= radius) t.push_back(h);
+  return t;
+}
+
+TEST(SelectiveCases, RadialRegionsAtACornerForIntervalsFiveToThirty) {
+  // Table G-3: unit brick, hexes within 0.5 of the corner (1, 1, 1), interval n.
+  for (int n : {5, 10, 15, 20, 25, 30}) {
+    BrickParams bp;
+    bp.dims = {n, n, n};
+    const HexMesh m = generate_brick(bp);
+    const std::vector<int32_t> t = hexes_within(m, {1, 1, 1}, 0.5);
+    RefineResult r;
+    const MeshCheckReport c = refine_and_check(m, t, &r);
+    EXPECT_TRUE(c.valid()) << "interval " << n;
+    EXPECT_EQ(c.doublets, 0);
+    if (n >= 10) {
+      EXPECT_GT(r.stats.directional_hexes, 0) << "interval " << n;
+    }
+    // Targets, and the hexes whose twelve edges all got split by their neighbours.
+    EXPECT_GE(r.stats.hexes_per_template.at("1-27"), 27 * static_cast<int64_t>(t.size()));
+  }
+}
+
+TEST(SelectiveCases, GearTeethCylinderAndTwistedRing) {
+  {
+    const HexMesh gear = generate_gear({});
+    std::vector<int32_t> teeth;
+    const auto* block = mesh_find_attribute(gear, attribute_block_id);
+    ASSERT_NE(block, nullptr);
+    for (int32_t h = 0; h < gear.hex_count(); ++h)
+      if ((*block)[h] == 2) teeth.push_back(h);
+    const MeshCheckReport c = refine_and_check(gear, teeth);
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(c.doublets, 0);
+  }
+  {
+    const HexMesh cyl = generate_cylinder({});
+    const MeshCheckReport c = refine_and_check(cyl, hexes_within(cyl, {0, 0, 0.5}, 0.5));
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(c.doublets, 0);
+  }
+  {
+    // Targets: the hexes of the ring's self-intersecting sheet (section 3 x 3: the middle one).
+    TwistedRingParams rp;
+    rp.section_intervals = 3;
+    const HexMesh ring = generate_twisted_ring(rp);
+    const HexTopology topo = topology_build(ring);
+    const DualSheets d = dual_build(ring, topo);
+    int32_t sheet = -1;
+    for (int32_t s = 0; s < d.sheet_count(); ++s)
+      if (d.sheets[s].self_intersecting) sheet = s;
+    ASSERT_GE(sheet, 0);
+    const auto hexes = sheet_hexes(d, sheet);
+    const MeshCheckReport c =
+        refine_and_check(ring, std::vector<int32_t>(hexes.begin(), hexes.end()));
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(c.doublets, 0);
+  }
+}
+
+TEST(SelectiveCases, SphereRegionsInsideRealMeshes) {
+  // Real meshes with warped boundary quads: the checker's centroid test reports the trapezoid
+  // sub-faces of 1-4 face templates on warped boundary faces as non-conformal (their corner
+  // average is off the bilinear patch); the topology is conformal: no hanging node, no gap
+  // (the suite's check: every output boundary face lies on the input's boundary), no inverted
+  // hex, no doublet.
+  struct Case {
+    std::string file;
+    Eigen::Vector3d centre;
+    double radius;
+  };
+  for (const Case& k :
+       {Case{"ellipsoid.mesh", {0, 0, 0}, 0.1}, Case{"ellipsoid.mesh", {0, 0, 0}, 0.25},
+        Case{"rockerarm.mesh", {0, 0, 0}, 8}}) {
+    const HexMesh m = mesh_read(shared_mesh(k.file));
+    const std::vector<int32_t> t = hexes_within(m, k.centre, k.radius);
+    ASSERT_FALSE(t.empty());
+    RefineResult r;
+    const MeshCheckReport c = refine_and_check(m, t, &r);
+    EXPECT_EQ(c.inverted_hexes, 0) << k.file;
+    EXPECT_EQ(c.doublets, 0) << k.file;
+    EXPECT_EQ(c.hanging_nodes, 0) << k.file;
+    EXPECT_EQ(c.nonmanifold_faces, 0) << k.file;
+    EXPECT_EQ(c.nonmanifold_boundary_edges, 0) << k.file;
+    EXPECT_LT(c.volume_relative_error, 1e-6) << k.file;
+    const HexMesh& out = r.mesh;
+    const HexTopology ot = topology_build(out);
+    EXPECT_TRUE(ot.nonmanifold_faces.empty());
+  }
+}
+
+// A brick whose hexes list their nodes in a random rotation each: same geometry, local axes no
+// longer aligned from hex to hex (as in an unstructured mesh).
+HexMesh brick_with_rotated_hexes(int n, uint64_t seed) {
+  BrickParams bp;
+  bp.dims = {n, n, n};
+  HexMesh m = generate_brick(bp);
+  std::mt19937_64 rng(seed);
+  std::vector<int> proper;
+  for (int s = 0; s < 48; ++s)
+    if (!cube_symmetries()[s].reflection) proper.push_back(s);
+  for (HexCell& c : m.hexes) {
+    const CubeSymmetry& s = cube_symmetries()[proper[rng() % proper.size()]];
+    HexCell r{};
+    for (int v = 0; v < 8; ++v) r[v] = c[s.vertex[v]];
+    c = r;
+  }
+  return m;
+}
+
+TEST(SelectiveAblation, NoRankingBreaksConformityOnTheRadialCase) {
+  const HexMesh m = brick_with_rotated_hexes(10, 3);
+  const std::vector<int32_t> t = hexes_within(m, {1, 1, 1}, 0.5);
+  const MeshCheckReport ranked = refine_and_check(m, t);
+  EXPECT_TRUE(ranked.valid());
+  RefineOptions o;
+  o.ranking = false;
+  const MeshCheckReport unranked = refine_and_check(m, t, nullptr, o);
+  EXPECT_FALSE(unranked.conformal);
+  EXPECT_GT(unranked.non_conformal_faces, 0);
+  std::printf("no-ranking: %ld non-conformal faces, %ld hanging nodes\n",
+              long(unranked.non_conformal_faces), long(unranked.hanging_nodes));
+  o = {};
+  o.propagation = false;
+  EXPECT_GT(refine_and_check(m, t, nullptr, o).non_conformal_faces, 0);
+  o = {};
+  o.ebe_only = true;
+  RefineResult ebe;
+  EXPECT_GT(refine_and_check(m, t, &ebe, o).non_conformal_faces, 0);
+  EXPECT_EQ(ebe.stats.hexes_per_template.count("directional"), 0u);
+}
+
+TEST(SelectivePasses, RegionRefinedTwiceWithAndWithoutBuffer) {
+  const HexMesh m = fixture_brick(4, 4, 4);
+  std::vector<int32_t> left;
+  for (int32_t h = 0; h < m.hex_count(); ++h)
+    if (h % 4 == 0) left.push_back(h);
+  RefineOptions o;
+  o.passes = 2;
+  RefineResult plain;
+  EXPECT_TRUE(refine_and_check(m, left, &plain, o).valid());
+  // Pass 2 targets the 16 x 27 children of the targets: 432 x 27 of them after two passes.
+  EXPECT_EQ(plain.stats.hexes_per_template.at("1-27"), 16 * 27 * 27);
+  o.buffer = true;
+  RefineResult buffered;
+  EXPECT_TRUE(refine_and_check(m, left, &buffered, o).valid());
+  EXPECT_GT(buffered.stats.added_targets, 0);
+  EXPECT_GT(buffered.mesh.hex_count(), plain.mesh.hex_count());
+}
+
+TEST(Selective, RefusesInvertedInputAndBadTargets) {
+  HexMesh m = fixture_brick(2, 1, 1);
+  std::swap(m.hexes[1][0], m.hexes[1][1]);
+  std::swap(m.hexes[1][4], m.hexes[1][5]);
+  std::swap(m.hexes[1][3], m.hexes[1][2]);
+  std::swap(m.hexes[1][7], m.hexes[1][6]);
+  EXPECT_THROW(selective_refine(m, {{0}}, {}), InputError);
+  RefineOptions o;
+  o.allow_inverted = true;
+  EXPECT_NO_THROW(selective_refine(m, {{0}}, o));
+  EXPECT_THROW(selective_refine(fixture_brick(1, 1, 1), {{5}}, {}), InputError);
+}
+
+}  // namespace
+}  // namespace hexrefine
+
+namespace hexrefine {
+namespace {
+
+// Writes the JSON behind results/templates.md, results/selective_random.md and
+// results/selective_cases.md. Run by hand:
+//   algorithms_tests --gtest_also_run_disabled_tests --gtest_filter='*WriteResults*'
+TEST(SelectiveResults, DISABLED_WriteResults) {
+  const std::string dir = std::string(HEXREFINE_SOURCE_DIR) + "/results/";
+  {
+    nlohmann::json j = nlohmann::json::array();
+    const HexTemplate* all[] = {&template_1_27(),       &template_1_13(), &template_1_5(),
+                                &template_1_4(),        &template_1_3(),  &template_1_3_adjust1(),
+                                &template_1_3_adjust2()};
+    for (const HexTemplate* t : all)
+      j.push_back({{"template", template_tag_name(t->tag)},
+                   {"split_edges", __builtin_popcount(template_split_edges(*t))},
+                   {"children", t->children.size()},
+                   {"min_scaled_jacobian_alone", template_validate(*t)}});
+    std::ofstream(dir + "templates.json") << j.dump(2) << "\n";
+  }
+  {
+    nlohmann::json cases = nlohmann::json::array();
+    auto record = [&](const std::string& name, const HexMesh& m, const std::vector<int32_t>& t,
+                      const RefineOptions& o = {}) {
+      nlohmann::json c = {{"case", name}, {"targets", t.size()}};
+      try {
+        const RefineResult r = selective_refine(m, {t}, o);
+        const MeshCheckReport k = mesh_check(r.mesh, &m);
+        c["stats"] = refine_stats_to_json(r.stats);
+        c["check"] = mesh_check_to_json(k);
+      } catch (const OperationError& e) {
+        c["refused"] = e.what();
+      }
+      cases.push_back(c);
+    };
+    {
+      const HexMesh m = fixture_brick(10, 10, 10);
+      std::vector<int32_t> t;
+      for (int32_t h = 0; h < m.hex_count(); ++h)
+        if (h % 10 == 0 || h / 100 == 0) t.push_back(h);
+      record("L-shaped 10x10x10 (Table G-1)", m, t);
+      RefineOptions o;
+      o.ranking = false;
+      record("L-shaped, --no-ranking", m, t, o);
+      o = {};
+      o.propagation = false;
+      record("L-shaped, --no-propagation", m, t, o);
+      o = {};
+      o.ebe_only = true;
+      record("L-shaped, --ebe-only", m, t, o);
+    }
+    for (int n : {5, 10, 15, 20, 25, 30}) {
+      BrickParams bp;
+      bp.dims = {n, n, n};
+      const HexMesh m = generate_brick(bp);
+      record("radial r=0.5 at corner, interval " + std::to_string(n) + " (Table G-3)", m,
+             hexes_within(m, {1, 1, 1}, 0.5));
+    }
+    {
+      const HexMesh m = brick_with_rotated_hexes(10, 3);
+      const std::vector<int32_t> t = hexes_within(m, {1, 1, 1}, 0.5);
+      record("radial interval 10, hexes in random local orientations", m, t);
+      RefineOptions o;
+      o.ranking = false;
+      record("radial interval 10, random orientations, --no-ranking", m, t, o);
+      o = {};
+      o.propagation = false;
+      record("radial interval 10, random orientations, --no-propagation", m, t, o);
+      o = {};
+      o.ebe_only = true;
+      record("radial interval 10, random orientations, --ebe-only", m, t, o);
+    }
+    {
+      const HexMesh gear = generate_gear({});
+      std::vector<int32_t> teeth;
+      const auto* block = mesh_find_attribute(gear, attribute_block_id);
+      for (int32_t h = 0; h < gear.hex_count(); ++h)
+        if ((*block)[h] == 2) teeth.push_back(h);
+      record("gear teeth (block 2)", gear, teeth);
+      const HexMesh cyl = generate_cylinder({});
+      record("O-grid cylinder, sphere r=0.5 at (0,0,0.5)", cyl,
+             hexes_within(cyl, {0, 0, 0.5}, 0.5));
+      for (const auto& [file, c, r] :
+           {std::tuple{"ellipsoid.mesh", Eigen::Vector3d(0, 0, 0), 0.1},
+            std::tuple{"ellipsoid.mesh", Eigen::Vector3d(0, 0, 0), 0.25},
+            std::tuple{"ellipsoid.mesh", Eigen::Vector3d(0.1, 0.1, 0.3), 0.12},
+            std::tuple{"rockerarm.mesh", Eigen::Vector3d(0, 0, 0), 8.0},
+            std::tuple{"rockerarm.mesh", Eigen::Vector3d(0, 0, 20), 10.0}}) {
+        const HexMesh m = mesh_read(shared_mesh(file));
+        std::ostringstream name;
+        name << file << ", sphere r=" << r << " at (" << c.transpose() << ")";
+        record(name.str(), m, hexes_within(m, c, r));
+      }
+      TwistedRingParams rp;
+      rp.section_intervals = 3;
+      const HexMesh ring = generate_twisted_ring(rp);
+      const HexTopology topo = topology_build(ring);
+      const DualSheets d = dual_build(ring, topo);
+      for (int32_t s = 0; s < d.sheet_count(); ++s)
+        if (d.sheets[s].self_intersecting) {
+          const auto hs = sheet_hexes(d, s);
+          record("twisted ring 3x3, the self-intersecting sheet", ring,
+                 std::vector<int32_t>(hs.begin(), hs.end()));
+          break;
+        }
+    }
+    std::ofstream(dir + "selective_cases.json") << cases.dump(2) << "\n";
+  }
+  {
+    // The random suite of SelectiveRandom.TargetSetsOnJitteredBricks, with its refusals.
+    nlohmann::json j;
+    const char* kinds[] = {
+        "uniform",    "checkerboard", "isolated", "edge-contact pairs", "vertex-contact pairs",
+        "sphere blob"};
+    std::map<std::string, std::array<int, 4>> per_kind;  // sets, refined, refused, empty
+    nlohmann::json refused = nlohmann::json::array();
+    for (int n : {4, 6}) {
+      BrickParams bp;
+      bp.dims = {n, n, n};
+      bp.size = {double(n), double(n), double(n)};
+      bp.jitter = 0.2;
+      bp.seed = 7;
+      const HexMesh m = generate_brick(bp);
+      for (uint64_t seed = 1; seed <= 1000; ++seed) {
+        const uint64_t s = seed * 7919 + n;
+        const std::vector<int32_t> t = random_targets(n, s);
+        auto& k = per_kind[std::to_string(n) + "^3 " + kinds[s % 6]];
+        ++k[0];
+        if (t.empty()) {
+          ++k[3];
+          continue;
+        }
+        try {
+          const RefineResult r = selective_refine(m, {t}, {});
+          const MeshCheckReport c = mesh_check(r.mesh, &m);
+          EXPECT_TRUE(c.valid() && c.doublets == 0);
+          ++k[1];
+        } catch (const OperationError& e) {
+          ++k[2];
+          refused.push_back({{"n", n},
+                             {"seed", s},
+                             {"kind", kinds[s % 6]},
+                             {"targets", t},
+                             {"message", e.what()}});
+        }
+      }
+    }
+    for (const auto& [name, k] : per_kind)
+      j["per_kind"][name] = {
+          {"sets", k[0]}, {"refined_valid", k[1]}, {"refused", k[2]}, {"empty", k[3]}};
+    j["refused"] = refused;
+    std::ofstream(dir + "selective_random.json") << j.dump(2) << "\n";
+  }
 }
 
 }  // namespace

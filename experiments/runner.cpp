@@ -332,7 +332,6 @@ JsonlContent jsonl_read(const std::string& path) {
     const bool complete = end != std::string::npos;
     const std::string row = text.substr(start, complete ? end - start : std::string::npos);
     const size_t next = complete ? end + 1 : text.size();
-    const bool last = next >= text.size();
     if (row.find_first_not_of(" \t\r") == std::string::npos) {
       if (complete) out.valid_text.append(text, start, next - start);
       start = next;
@@ -345,14 +344,13 @@ JsonlContent jsonl_read(const std::string& path) {
     } catch (const json::parse_error&) {
       ok = false;
     }
-    if (!complete || !ok) {
-      // A killed writer leaves at most one partial line, at the end.
-      if (last) {
-        out.truncated_tail = true;
-        break;
-      }
-      throw InputError(error_at(path, line, "not a JSON record"));
+    if (!complete) {
+      // A killed writer leaves at most one partial line: the end of the file, without its
+      // newline (jsonl_append writes the newline last).
+      out.truncated_tail = true;
+      break;
     }
+    if (!ok) throw InputError(error_at(path, line, "not a JSON record"));
     try {
       run_record_key(record);
     } catch (const InputError& e) {

@@ -74,10 +74,10 @@ std::string run_record_key(const std::string& case_name, const std::string& meth
 /// run_record_key of a record read back from a file; InputError if a key field is missing.
 std::string run_record_key(const nlohmann::json& record);
 
-/// Records of a JSON Lines file. A last line that is incomplete (no final newline, or not valid
-/// JSON and not followed by anything: what a killed writer leaves) is dropped and reported in
-/// `truncated_tail`; any other bad line is an InputError naming the file and line. A missing
-/// file gives no records.
+/// Records of a JSON Lines file. A last line without its final newline (what a killed writer
+/// leaves, since jsonl_append writes the newline last) is dropped, even if it parses, and
+/// reported in `truncated_tail`; any other bad line is an InputError naming the file and line.
+/// A missing file gives no records.
 struct JsonlContent {
   std::vector<nlohmann::json> records;
   bool truncated_tail = false;

@@ -249,6 +249,8 @@ TEST(Jsonl, DropsTruncatedLastLineOnly) {
   EXPECT_EQ(c.records.size(), 1u);
   EXPECT_TRUE(c.truncated_tail);
   // A bad line in the middle is bad input, named by line.
+  file_put(path, good + "garbage\n");
+  EXPECT_EQ(input_error_of([&] { jsonl_read(path); }), path + ":2: not a JSON record");
   file_put(path, good + "garbage\n" + good);
   EXPECT_EQ(input_error_of([&] { jsonl_read(path); }), path + ":2: not a JSON record");
   file_put(path, good + "{\"case\":\"a\"}\n");

@@ -249,6 +249,8 @@ TEST(Jsonl, DropsTruncatedLastLineOnly) {
   EXPECT_EQ(c.records.size(), 1u);
   EXPECT_TRUE(c.truncated_tail);
   // A bad line in the middle is bad input, named by line.
+  file_put(path, good + "garbage\n");
+  EXPECT_EQ(input_error_of([&] { jsonl_read(path); }), path + ":2: not a JSON record");
   file_put(path, good + "garbage\n" + good);
   EXPECT_EQ(input_error_of([&] { jsonl_read(path); }), path + ":2: not a JSON record");
   file_put(path, good + "{\"case\":\"a\"}\n");
@@ -275,6 +277,7 @@ TEST(RunPlanExecute, WritesOneRecordPerCaseAndMethod) {
   EXPECT_EQ(records[4]["final_hexes"], 81);
   EXPECT_EQ(records[5]["final_hexes"], 102);
   EXPECT_EQ(records[0]["commit"], "abc123");
+  EXPECT_EQ(records[0]["commit_dirty"], false);
   EXPECT_EQ(records[0]["machine"]["cpu"], "test cpu");
   EXPECT_EQ(records[0]["machine"]["cores"], 2);
   EXPECT_EQ(records[0]["build_type"], "release");
@@ -406,6 +409,15 @@ TEST(RunShard, ShardsPartitionTheCasesAndMergeRestoresTheOrder) {
   EXPECT_EQ(merged[6]["final_hexes"], -7);
   jsonl_write((dir / "merged.jsonl").string(), merged);
   EXPECT_EQ(jsonl_read((dir / "merged.jsonl").string()).records, merged);
+}
+
+TEST(RunEnvironment, DetectsCommitMachineAndBuild) {
+  const RunEnvironment env = run_environment_detect();
+  // The tests run from a git checkout of the source tree.
+  EXPECT_EQ(env.commit.size(), 40u) << env.commit;
+  EXPECT_GE(env.cores, 1);
+  EXPECT_FALSE(env.cpu.empty());
+  EXPECT_TRUE(env.build_type == "release" || env.build_type == "debug");
 }
 
 TEST(RunMeshFileName, ReplacesPathCharacters) {

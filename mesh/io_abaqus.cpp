@@ -247,11 +247,7 @@ void abaqus_write(const std::string& path, const HexMesh& mesh) {
   const std::vector<int32_t>* block = mesh_find_attribute(mesh, attribute_block_id);
   file_write_atomically(path, [&](std::ostream& out) {
     std::string s;
-    auto flush = [&](bool force) {
-      if (!force && s.size() < (1 << 16)) return;
-      out.write(s.data(), static_cast<std::streamsize>(s.size()));
-      s.clear();
-    };
+    const io_detail::ChunkFlush flush{out, s};
     s += "*HEADING\nhexrefine mesh\n*NODE\n";
     for (size_t i = 0; i < mesh.points.size(); ++i) {
       const Eigen::Vector3d& p = mesh.points[i];

@@ -322,11 +322,7 @@ void gmsh_write(const std::string& path, const HexMesh& mesh,
     if (blocks.empty() || blocks.back() != b) blocks.push_back(b);
   file_write_atomically(path, [&](std::ostream& out) {
     std::string s;
-    auto flush = [&](bool force) {
-      if (!force && s.size() < (1 << 16)) return;
-      out.write(s.data(), static_cast<std::streamsize>(s.size()));
-      s.clear();
-    };
+    const io_detail::ChunkFlush flush{out, s};
     s += "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
     s += "$Entities\n0 0 0 " + std::to_string(blocks.size()) + "\n";
     size_t i = 0;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <ostream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -280,5 +281,17 @@ HexMesh exodus_read(const std::string& path);
 void exodus_write(const std::string& path, const HexMesh& mesh);
 HexMesh abaqus_read(const std::string& path);
 void abaqus_write(const std::string& path, const HexMesh& mesh);
+
+/// Writers build text in a string and hand it to the stream in 64 KiB pieces (one write per
+/// piece, not per number): `flush(false)` writes once the piece is full, `flush(true)` always.
+struct ChunkFlush {
+  std::ostream& out;
+  std::string& text;
+  void operator()(bool force) const {
+    if (!force && text.size() < (1 << 16)) return;
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    text.clear();
+  }
+};
 
 }  // namespace hexrefine::io_detail

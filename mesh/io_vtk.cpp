@@ -407,11 +407,7 @@ void vtk_write(const std::string& path, const HexMesh& mesh, const bool binary,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars) {
   file_write_atomically(path, [&](std::ostream& out) {
     std::string s;
-    auto flush = [&](bool force) {
-      if (!force && s.size() < (1 << 16)) return;
-      out.write(s.data(), static_cast<std::streamsize>(s.size()));
-      s.clear();
-    };
+    const io_detail::ChunkFlush flush{out, s};
     const size_t n = mesh.points.size(), m = mesh.hexes.size();
     s += "# vtk DataFile Version 3.0\nhexrefine mesh\n";
     s += binary ? "BINARY\n" : "ASCII\n";
@@ -488,11 +484,7 @@ void vtu_write(const std::string& path, const HexMesh& mesh,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars) {
   file_write_atomically(path, [&](std::ostream& out) {
     std::string s;
-    auto flush = [&](bool force) {
-      if (!force && s.size() < (1 << 16)) return;
-      out.write(s.data(), static_cast<std::streamsize>(s.size()));
-      s.clear();
-    };
+    const io_detail::ChunkFlush flush{out, s};
     const size_t n = mesh.points.size(), m = mesh.hexes.size();
     s += "<?xml version=\"1.0\"?>\n";
     s += "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "

@@ -47,7 +47,14 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
   cases.push_back(piston);
   json gear = make_case("H-1", json{{"generate", "gear"}}, {"block:2"}, {{"table", "H-1"}});
   gear["smooth"] = true;
+  gear["save_mesh"] = true;
   cases.push_back(gear);
+  // A twisted ring (3x3 section: its in-section sheets cross themselves) refined around one
+  // place: the self-intersecting sheets the thesis says sheet refinement must special-case.
+  json ring = make_case("ring", json{{"generate", "twisted-ring"}, {"section_intervals", 3}},
+                        {"sphere:1,0,0,0.6"}, {{"table", "ring"}});
+  ring["save_mesh"] = true;
+  cases.push_back(ring);
   for (const bool buffer : {true, false}) {
     json c = make_case(buffer ? "H-2" : "H-2/no-buffer", brick(4, 4, 4), {"boundary:-1,0,0"},
                        {{"table", "H-2"}, {"buffer", buffer}});
@@ -84,9 +91,12 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
   for (const int n : thesis_sweep_intervals(quick))
     cases.push_back(make_case("G-2/n=" + std::to_string(n), brick(n, n, n), {"all"},
                               {{"table", "G-2"}, {"n", n}}));
-  for (const int n : thesis_sweep_intervals(quick))
-    cases.push_back(make_case("G-3/n=" + std::to_string(n), brick(n, n, n), {corner_ball},
-                              {{"table", "G-3"}, {"n", n}}));
+  for (const int n : thesis_sweep_intervals(quick)) {
+    json c = make_case("G-3/n=" + std::to_string(n), brick(n, n, n), {corner_ball},
+                       {{"table", "G-3"}, {"n", n}});
+    if (n == 10) c["save_mesh"] = true;  // the radial region's picture
+    cases.push_back(c);
+  }
 
   return json{{"description", std::string("Parrish's thesis suite (hexrefine reproduce") +
                                   (quick ? " --quick" : "") + "); see results/README.md"},

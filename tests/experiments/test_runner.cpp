@@ -445,8 +445,8 @@ TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
     const json root = thesis_suite_cases(quick, meshes, "thesis.jsonl");
     const RunPlan plan = run_plan_parse(root, "suite.json", "/");
     const size_t sweep = quick ? 6 : 15;  // n = 5..30 or 5..75
-    // G-1, 6-1, 6-2, H-1, H-2 (two), H-3, H-4, real, 6 ablations, two sweeps.
-    EXPECT_EQ(plan.cases.size(), 15u + 2 * sweep);
+    // G-1, 6-1, 6-2, H-1, ring, H-2 (two), H-3, H-4, real, 6 ablations, two sweeps.
+    EXPECT_EQ(plan.cases.size(), 16u + 2 * sweep);
     int g2 = 0, ablations = 0;
     for (const RunCase& c : plan.cases) {
       if (c.tags.value("table", "") == "G-2") {
@@ -466,6 +466,12 @@ TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
     EXPECT_TRUE(plan.cases[0].save_mesh);
     EXPECT_EQ(plan.cases[1].name, "6-1");
     EXPECT_TRUE(plan.cases[1].save_mesh);
+    // Pictures: the L-shaped brick, the stepped model, the gear teeth, the twisted ring and the
+    // radial region (G-3 at n = 10).
+    std::vector<std::string> saved;
+    for (const RunCase& c : plan.cases)
+      if (c.save_mesh) saved.push_back(c.name);
+    EXPECT_EQ(saved, (std::vector<std::string>{"G-1", "6-1", "H-1", "ring", "G-3/n=10"}));
     EXPECT_EQ(plan.cases[0].mesh["dims"], json({10, 10, 10}));
     EXPECT_EQ(plan.cases[0].select,
               (std::vector<std::string>{"boundary:-1,0,0", "boundary:0,0,-1"}));

@@ -40,7 +40,7 @@
 /// hex, so this ends). What still fails throws OperationError naming the input hexes.
 /// Cost: marking, worklists and ranking touch only the hexes around split edges; each cell is
 /// refined once per direction; the whole-mesh work is building the topology, copying, and the
-/// self-check, once per attempt (attempts are rare: 5 restarts in 2,000 random target sets).
+/// self-check, once per attempt (further attempts are rare: only configurations that need them).
 
 #include "algorithms/selective.hpp"
 

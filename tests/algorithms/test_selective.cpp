@@ -1,4 +1,5 @@
 #include "algorithms/selective.hpp"
+#include "algorithms/sheet.hpp"
 
 #include <gtest/gtest.h>
 
@@ -36,6 +37,20 @@ TEST(Selective, SharedRefinerSuite) {
   ASSERT_EQ(sizes.size(), 6u);
   EXPECT_EQ(sizes[2], 8060);   // L-shaped
   EXPECT_EQ(sizes[4], 55272);  // gear teeth (thesis H-1: 63,093 on its own gear)
+}
+
+TEST(RefinerSuite, BothRefinersPassAndAgreeWhereTheThesisSaysTheyDo) {
+  const std::vector<int64_t> selective = refiner_suite_run(selective_refine);
+  const std::vector<int64_t> sheet =
+      refiner_suite_run([](const HexMesh& m, const Targets& t, const RefineOptions& o) {
+        return sheet_refine(m, t, o);
+      });
+  ASSERT_EQ(selective.size(), sheet.size());
+  EXPECT_EQ(selective[0], sheet[0]);  // full bricks: 27 n^3 both
+  EXPECT_EQ(selective[1], sheet[1]);
+  EXPECT_EQ(sheet[2], 27000);  // L-shaped: sheet refinement refines the whole brick (G-1)
+  EXPECT_EQ(selective[2], 8060);
+  EXPECT_EQ(selective[4], sheet[4]);  // gear teeth: no multiply-connected transition (H-1)
 }
 
 TEST(Selective, ElementByElementAdjustmentsAreConformal) {

@@ -132,9 +132,14 @@ class Smoother {
     trial_samples_.resize(valence * 9);
     quality_.resize(mesh.hexes.size());
     for (int32_t h = 0; h < mesh.hex_count(); ++h) quality_[h] = hex_quality(h);
+    input_ = mesh.points;
   }
 
+  /// Scaled Jacobian of every hex at the current positions (kept up to date by every move).
   const std::vector<double>& quality() const { return quality_; }
+
+  /// Node positions before smoothing.
+  const std::vector<Vec3>& input_points() const { return input_; }
 
   /// Visits node n once; returns the distance it moved.
   double node_visit(int32_t n) {
@@ -176,19 +181,13 @@ class Smoother {
   Vec3 node_constrain(int32_t n, const Vec3& x) const {
     if (!node_is_planar(n)) return x;
     const Vec3& normal = classes_.normal[n];
-    return x - (x - plane_point(n)).dot(normal) * normal;
+    return x - (x - input_[n]).dot(normal) * normal;
   }
 
-  Vec3 plane_point(int32_t n) const { return original_[n]; }
-
- public:
-  /// Remembers the input positions (planar nodes slide in the plane through them).
-  void remember_input() { original_ = mesh_.points; }
-
- private:
   /// Evaluates the hexes around n with n at x. Returns false if a hex with a positive scaled
-  /// Jacobian would become non-positive; `local_min` receives the new local minimum. The trial
-  /// values stay in trial_quality_ for node_commit.
+  /// Jacobian would become non-positive; `local_min` receives the new local minimum and
+  /// `sum_gain` (if given) the change of the sum of their scaled Jacobians. The trial values stay
+  /// in trial_quality_ for node_commit.
   bool node_trial(int32_t n, const Vec3& x, double& local_min, double* sum_gain = nullptr) {
     const Vec3 keep = mesh_.points[n];
     mesh_.points[n] = x;
@@ -388,7 +387,7 @@ class Smoother {
       if (!(gradient.norm() > 1e-12 / scale)) return;
       const Vec3 direction = gradient.normalized();
       bool moved = false;
-      for (; step > 1e-7 * scale; step *= 0.5) {
+      for (int halving = 0; halving < 10; ++halving, step *= 0.5) {
         const Vec3 candidate = node_constrain(n, x + step * direction);
         double candidate_min;
         if (node_trial(n, candidate, candidate_min) && candidate_min > local_min + 1e-12) {
@@ -412,7 +411,7 @@ class Smoother {
   SmoothMethod method_;
   std::vector<int32_t> neighbour_offsets_, neighbours_;
   std::vector<double> quality_, trial_quality_, trial_samples_;
-  std::vector<Vec3> original_;
+  std::vector<Vec3> input_;  ///< planar nodes slide in the plane through their input position
 };
 
 void stats_min_mean(const std::vector<double>& quality, double& min, double& mean) {
@@ -494,6 +493,9 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
     throw InputError("mesh_smooth: feature angle must be in (0, 180) degrees, got " +
                      std::to_string(options.feature_angle_degrees));
   mesh_validate_ids(mesh, "mesh_smooth");
+  for (int32_t n = 0; n < mesh.point_count(); ++n)
+    if (!mesh.points[n].allFinite())
+      throw InputError("mesh_smooth: node " + std::to_string(n) + " has a non-finite coordinate");
   for (int32_t h : options.region_hexes)
     if (h < 0 || h >= mesh.hex_count())
       throw InputError("mesh_smooth: region hex " + std::to_string(h) + " out of range 0.." +
@@ -514,8 +516,6 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
       movable.push_back(n);
 
   Smoother smoother(mesh, topology, classes, options.method);
-  smoother.remember_input();
-  const std::vector<Vec3> input = mesh.points;
   stats_min_mean(smoother.quality(), stats.min_scaled_jacobian_before, stats.mean_before);
   double current_min = stats.min_scaled_jacobian_before, current_mean = stats.mean_before;
 
@@ -563,7 +563,7 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
 
   stats_min_mean(smoother.quality(), stats.min_scaled_jacobian_after, stats.mean_after);
   for (int32_t n = 0; n < mesh.point_count(); ++n)
-    if (mesh.points[n] != input[n]) ++stats.nodes_moved;
+    if (mesh.points[n] != smoother.input_points()[n]) ++stats.nodes_moved;
   stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   return stats;

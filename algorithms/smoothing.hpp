@@ -69,7 +69,7 @@ SmoothNodeClasses mesh_classify_smooth_nodes(const HexMesh& mesh, const HexTopol
 /// Jacobian of the hexes around each node, ties by node id) and stop after `max_sweeps` or when a
 /// sweep no longer changes the mesh noticeably. Throws InputError for bad options (negative
 /// sweeps, feature angle outside (0, 180), region hex id out of range) or a mesh failing
-/// mesh_validate_ids.
+/// mesh_validate_ids or holding a non-finite coordinate.
 SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options);
 
 /// The report of `hexrefine smooth` (and `refine --smooth`): min/mean scaled Jacobian before and

@@ -33,9 +33,14 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
   const std::string corner_ball = "sphere:1,0,1,0.5";
   json cases = json::array();
 
-  cases.push_back(make_case("G-1", brick(10, 10, 10), l_shape, {{"table", "G-1"}}));
-  cases.push_back(
-      make_case("6-1", json{{"generate", "stepped"}}, {"boundary:1,0,0"}, {{"table", "6-1"}}));
+  // The small ones keep their refined meshes for experiments/render_mesh.py.
+  json g1 = make_case("G-1", brick(10, 10, 10), l_shape, {{"table", "G-1"}});
+  g1["save_mesh"] = true;
+  cases.push_back(g1);
+  json stepped =
+      make_case("6-1", json{{"generate", "stepped"}}, {"boundary:1,0,0"}, {{"table", "6-1"}});
+  stepped["save_mesh"] = true;
+  cases.push_back(stepped);
   json piston = make_case("6-2", json{{"file", meshes_dir + "/ellipsoid.mesh"}},
                           {"boundary:0,0,1,45"}, {{"table", "6-2"}});
   piston["smooth"] = true;

@@ -28,6 +28,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 SINGLE_TABLES = ["G-1", "6-1", "6-2", "H-1", "H-2", "H-3", "H-4"]
 SWEEPS = ["G-2", "G-3"]
 METHODS = ["sheet", "selective"]  # the thesis' column order
+METHOD_COLOURS = {"selective": "tab:blue", "sheet": "tab:red"}
 
 
 def fail(message):
@@ -120,6 +121,8 @@ def single_table(name, case, thesis, records, out):
          lambda m: t.get(m, {}).get("final_hexes")),
         ("Time (s)", "time", lambda r: r.get("time_seconds"),
          lambda m: t.get(m, {}).get("seconds")),
+        ("CPU time (s)", "cpu", lambda r: r.get("cpu_seconds"),
+         lambda m: t.get(m, {}).get("seconds")),
         ("Initial minimum quality", "q0",
          lambda r: r.get("input", {}).get("initial_min_scaled_jacobian"),
          lambda m: t.get(m, {}).get("initial_min_quality")),
@@ -186,7 +189,8 @@ def sweep_series(name, records):
             continue
         ok = "error" not in r
         series[m].append((r.get("tags", {}).get("n"), r.get("initial_hexes"),
-                          r.get("time_seconds") if ok else None, r))
+                          r.get("time_seconds") if ok else None, r,
+                          r.get("cpu_seconds") if ok else None))
     for m in series:
         series[m].sort(key=lambda s: (s[0] is None, s[0]))
     return series
@@ -200,8 +204,9 @@ def sweep_table(name, thesis, records, out, exponents):
     if t.get("case"):
         out.append("Thesis: %s\n" % t["case"])
     out.append("| n | initial hexes | selective s (thesis) | selective s (ours) | ratio | "
-               "sheet s (thesis) | sheet s (ours) | ratio | final hexes sel / sheet | check sel / sheet |")
-    out.append("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+               "selective CPU s | sheet s (thesis) | sheet s (ours) | ratio | sheet CPU s | "
+               "final hexes sel / sheet | check sel / sheet |")
+    out.append("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     ns = sorted({s[0] for m in METHODS for s in series[m] if s[0] is not None})
     for n in ns:
         sel = next((s for s in series["selective"] if s[0] == n), None)
@@ -211,7 +216,8 @@ def sweep_table(name, thesis, records, out, exponents):
         cells = [str(n), fmt(init)]
         for s, col in ((sel, 2), (sh, 3)):
             theirs = th[col] if th else None
-            cells += [fmt(theirs), fmt(s[2] if s else None), ratio(s[2] if s else None, theirs)]
+            cells += [fmt(theirs), fmt(s[2] if s else None), ratio(s[2] if s else None, theirs),
+                      fmt(s[4] if s else None)]
         cells.append("%s / %s" % (fmt(sel[3].get("final_hexes") if sel else None),
                                   fmt(sh[3].get("final_hexes") if sh else None)))
         cells.append("%s / %s" % (outcome(sel[3] if sel else None), outcome(sh[3] if sh else None)))
@@ -219,19 +225,20 @@ def sweep_table(name, thesis, records, out, exponents):
     out.append("")
     for m, col in (("selective", 2), ("sheet", 3)):
         ours = fit_exponent([s[1] for s in series[m]], [s[2] for s in series[m]])
+        ours_cpu = fit_exponent([s[1] for s in series[m]], [s[4] for s in series[m]])
         rows_all = t.get("rows", [])
         theirs = fit_exponent([r[1] for r in rows_all], [r[col] for r in rows_all])
         ours_n = {s[0] for s in series[m] if s[2] is not None}
         same = [r for r in rows_all if r[0] in ours_n]
         theirs_same = fit_exponent([r[1] for r in same], [r[col] for r in same])
-        exponents.append((name, m, ours, theirs_same, theirs))
+        exponents.append((name, m, ours, ours_cpu, theirs_same, theirs))
     return series
 
 
 def sweep_plot(name, thesis, series, path):
     t = thesis.get(name, {})
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
-    colours = {"selective": "tab:blue", "sheet": "tab:red"}
+    colours = METHOD_COLOURS
     ours_max = max([s[1] for m in METHODS for s in series[m] if s[2] is not None and s[1]],
                    default=None)
     for ax, log in zip(axes, (False, True)):
@@ -240,6 +247,10 @@ def sweep_plot(name, thesis, series, path):
             if pts:
                 ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=colours[m],
                         label="%s (ours)" % m)
+            cpu = [(s[1], s[4]) for s in series[m] if s[4] is not None and s[1]]
+            if cpu:
+                ax.plot([p[0] for p in cpu], [p[1] for p in cpu], "o:", color=colours[m],
+                        markerfacecolor="none", label="%s (ours, CPU)" % m)
             # The linear panel stays within our range, else the thesis' sheet times hide ours.
             rows = [r for r in t.get("rows", [])
                     if r[1] > 0 and (log or ours_max is None or r[1] <= ours_max)]
@@ -274,6 +285,7 @@ def quality_plot(groups, path):
     for ax, case in zip(axes.flat, names):
         ax.set_visible(True)
         width = None
+        lowest = 0.0
         for offset, m in ((-0.5, "selective"), (0.5, "sheet")):
             r = next((x for _, x in cases if x["case"] == case and x["method"] == m), None)
             if not r:
@@ -282,9 +294,11 @@ def quality_plot(groups, path):
             width = h["bin_width"]
             lefts = [h["bin_edges_from"] + i * width for i in range(len(h["counts"]))]
             ax.bar([x + width / 2 + offset * width * 0.4 for x in lefts], h["counts"],
-                   width=width * 0.4, label=m, log=True)
+                   width=width * 0.4, label=m, log=True, color=METHOD_COLOURS[m])
+            used = [x for x, c in zip(lefts, h["counts"]) if c > 0]
+            lowest = min([lowest] + used[:1]) if used else lowest
         ax.set_title(case, fontsize=9)
-        ax.set_xlim(-0.1 if width else -1, 1.05)
+        ax.set_xlim(lowest - 0.1, 1.05)  # inverted hexes (negative bins) stay in view
         ax.set_xlabel("scaled Jacobian")
         ax.legend(fontsize=7)
     fig.tight_layout()
@@ -300,15 +314,20 @@ def ablation_table(records, groups, out):
     out.append("| base case | variant | final hexes | directional hexes | doublets resolved | "
                "time (s) | min scaled Jacobian | check |")
     out.append("|---|---|---:|---:|---:|---:|---:|---|")
+    bases = []
     for r in rows:
-        tags = r.get("tags", {})
-        base = record_of(records, tags.get("base"), "selective")
-        for variant, x in (("baseline", base), (tags.get("variant"), r)):
-            if variant == "baseline" and (x is None or tags.get("variant") != "no-ranking"):
-                continue  # the baseline row once per base case
+        base = r.get("tags", {}).get("base")
+        if base not in bases:
+            bases.append(base)
+    for base in bases:
+        # The unablated run first (the base case's own selective record), then each variant.
+        lines = [("baseline", record_of(records, base, "selective"))]
+        lines += [(r.get("tags", {}).get("variant"), r) for r in rows
+                  if r.get("tags", {}).get("base") == base]
+        for variant, x in lines:
             ok = x is not None and "error" not in x
             out.append("| %s | %s | %s | %s | %s | %s | %s | %s |" % (
-                tags.get("base"), variant, fmt(x.get("final_hexes") if ok else None),
+                base, variant, fmt(x.get("final_hexes") if ok else None),
                 fmt(x.get("directional_hexes") if ok else None),
                 fmt(x.get("doublets_resolved") if ok else None),
                 fmt(x.get("time_seconds") if ok else None),
@@ -351,9 +370,11 @@ def main():
     meta = records[0] if records else {}
     out = ["# Thesis tables: ours beside Parrish's\n",
            "Generated by `experiments/plots.py` from `%s` (%d records). Commit %s, %s build, "
-           "%s (%s cores), run %s. Times are refinement only (`time_seconds`), no I/O; the "
-           "thesis' times are from 2007-era hardware, so ratios of times compare scaling, not "
-           "machines. Quality = minimum hex scaled Jacobian. Ratio = ours / thesis.\n" % (
+           "%s (%s cores), run %s. Times are refinement only, no I/O: `time_seconds` (wall clock, "
+           "as the refiner measures it) and `cpu_seconds` (CPU time of the refiner call; the "
+           "refiners are single-threaded, so on a shared, loaded machine this is the better "
+           "measure). The thesis' times are from 2007-era hardware, so ratios of times compare "
+           "scaling, not machines. Quality = minimum hex scaled Jacobian. Ratio = ours / thesis.\n" % (
                os.path.basename(args.records), len(records), meta.get("commit", "?")[:12],
                meta.get("build_type", "?"), meta.get("machine", {}).get("cpu", "?"),
                meta.get("machine", {}).get("cores", "?"), meta.get("timestamp", "?"))]
@@ -372,11 +393,12 @@ def main():
             out.append("![%s time](plots/%s_time.png)\n" % (name, name))
     if exponents:
         out.append("### Fitted scaling exponents (time ∝ initial hexes^k, least squares in log-log)\n")
-        out.append("| sweep | method | k (ours) | k (thesis, same n) | k (thesis, n = 5..75) |")
-        out.append("|---|---|---:|---:|---:|")
-        for name, m, ours, theirs_same, theirs in exponents:
-            out.append("| %s | %s | %s | %s | %s |" % (name, m, fmt(ours, 3), fmt(theirs_same, 3),
-                                                     fmt(theirs, 3)))
+        out.append("| sweep | method | k (ours) | k (ours, CPU) | k (thesis, same n) | "
+                   "k (thesis, n = 5..75) |")
+        out.append("|---|---|---:|---:|---:|---:|")
+        for name, m, ours, ours_cpu, theirs_same, theirs in exponents:
+            out.append("| %s | %s | %s | %s | %s | %s |" % (
+                name, m, fmt(ours, 3), fmt(ours_cpu, 3), fmt(theirs_same, 3), fmt(theirs, 3)))
         out.append("")
     ablation_table(records, groups, out)
     other_table("Other regions of the real meshes", groups.get("real", []), out)

@@ -183,9 +183,9 @@ json parse_mesh(const json& j, const SchemaPath& p, const std::string& base_dir)
 
 RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_dir, int index) {
   schema_require_object(j, p);
-  schema_allow_keys(
-      j, p,
-      {"name", "description", "mesh", "select", "methods", "passes", "smooth", "options", "tags"});
+  schema_allow_keys(j, p,
+                    {"name", "description", "mesh", "select", "methods", "passes", "smooth",
+                     "save_mesh", "options", "tags"});
   RunCase c;
   c.index = index;
   if (!j.contains("name")) p.fail("missing \"name\"");
@@ -332,7 +332,6 @@ JsonlContent jsonl_read(const std::string& path) {
     const bool complete = end != std::string::npos;
     const std::string row = text.substr(start, complete ? end - start : std::string::npos);
     const size_t next = complete ? end + 1 : text.size();
-    const bool last = next >= text.size();
     if (row.find_first_not_of(" \t\r") == std::string::npos) {
       if (complete) out.valid_text.append(text, start, next - start);
       start = next;
@@ -345,14 +344,13 @@ JsonlContent jsonl_read(const std::string& path) {
     } catch (const json::parse_error&) {
       ok = false;
     }
-    if (!complete || !ok) {
-      // A killed writer leaves at most one partial line, at the end.
-      if (last) {
-        out.truncated_tail = true;
-        break;
-      }
-      throw InputError(error_at(path, line, "not a JSON record"));
+    if (!complete) {
+      // A killed writer leaves at most one partial line: the end of the file, without its
+      // newline (jsonl_append writes the newline last).
+      out.truncated_tail = true;
+      break;
     }
+    if (!ok) throw InputError(error_at(path, line, "not a JSON record"));
     try {
       run_record_key(record);
     } catch (const InputError& e) {
@@ -532,6 +530,18 @@ RunEnvironment run_environment_detect() {
         env.commit = text;
     }
   }
+  if (env.commit != "unknown") {
+    // Results must say whether they came from exactly that commit.
+    const std::string status =
+        "git -C '" + run_source_dir() + "' status --porcelain --untracked-files=no 2>/dev/null";
+    if (FILE* pipe = ::popen(status.c_str(), "r")) {
+      std::array<char, 64> buf{};
+      env.commit_dirty = fread(buf.data(), 1, buf.size(), pipe) > 0;
+      while (fread(buf.data(), 1, buf.size(), pipe) > 0) {
+      }
+      ::pclose(pipe);
+    }
+  }
   std::ifstream cpuinfo("/proc/cpuinfo");
   std::string line;
   while (std::getline(cpuinfo, line)) {
@@ -668,6 +678,7 @@ RunSummary run_plan_execute(const RunPlan& plan, const RunSettings& settings,
       record["options"] = options;
       record["tags"] = c.tags;
       record["commit"] = settings.environment.commit;
+      record["commit_dirty"] = settings.environment.commit_dirty;
       record["machine"] = {{"cpu", settings.environment.cpu},
                            {"cores", settings.environment.cores}};
       record["build_type"] = settings.environment.build_type;

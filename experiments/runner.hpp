@@ -74,10 +74,10 @@ std::string run_record_key(const std::string& case_name, const std::string& meth
 /// run_record_key of a record read back from a file; InputError if a key field is missing.
 std::string run_record_key(const nlohmann::json& record);
 
-/// Records of a JSON Lines file. A last line that is incomplete (no final newline, or not valid
-/// JSON and not followed by anything: what a killed writer leaves) is dropped and reported in
-/// `truncated_tail`; any other bad line is an InputError naming the file and line. A missing
-/// file gives no records.
+/// Records of a JSON Lines file. A last line without its final newline (what a killed writer
+/// leaves, since jsonl_append writes the newline last) is dropped, even if it parses, and
+/// reported in `truncated_tail`; any other bad line is an InputError naming the file and line.
+/// A missing file gives no records.
 struct JsonlContent {
   std::vector<nlohmann::json> records;
   bool truncated_tail = false;
@@ -119,6 +119,7 @@ std::string sha256_file(const std::string& path);
 /// Facts stamped on every record.
 struct RunEnvironment {
   std::string commit = "unknown";  ///< `git rev-parse HEAD` in the source dir
+  bool commit_dirty = false;       ///< tracked files differ from that commit
   std::string cpu = "unknown";     ///< "model name" of /proc/cpuinfo
   int cores = 0;                   ///< std::thread::hardware_concurrency()
   std::string build_type;          ///< "release" (NDEBUG) or "debug"

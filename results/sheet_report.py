@@ -46,7 +46,14 @@ def main():
           "sheet passes | wall ms | CPU ms | CPU us / initial hex |")
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     by_case = {}
-    for name, b in rows.items():
+    order = {"sheet": 0, "sheet_one_per_pass": 1, "selective": 2}
+
+    def key(item):
+        case, method = case_and_method(item[0])
+        base, _, arg = case.partition("/")
+        return (base, int(arg) if arg else 0, order.get(method, 9))
+
+    for name, b in sorted(rows.items(), key=key):
         case, method = case_and_method(name)
         by_case.setdefault(case, {})[method] = b
         init = b["initial_hexes"]
@@ -66,7 +73,11 @@ def main():
         print("| case | sheet / selective (wall) | sheet / selective (CPU) | final hexes "
               "sheet / selective |")
         print("|---|---:|---:|---:|")
-        for c, s, p in ratios:
+        def case_key(case):
+            base, _, arg = case.partition("/")
+            return (base, int(arg) if arg else 0)
+
+        for c, s, p in sorted(ratios, key=lambda r: case_key(r[0])):
             print(f"| {c} | {s['real_time'] / p['real_time']:.2f} | "
                   f"{s['cpu_time'] / p['cpu_time']:.2f} | "
                   f"{s['final_hexes']:.0f} / {p['final_hexes']:.0f} |")

@@ -9,30 +9,19 @@
 
 #include "mesh/boundary_surface.hpp"
 #include "mesh/dual.hpp"
+#include "mesh/generators.hpp"
 #include "mesh/hex_mesh.hpp"
 #include "mesh/topology.hpp"
 
 namespace hexrefine {
 namespace {
 
-/// Unit n x n x n brick, nodes and hexes numbered x fastest (the layout of generate_brick without
-/// jitter), built here so the benchmark depends on the mesh layer only.
+/// Unit n x n x n brick without jitter (nodes and hexes numbered x fastest).
 HexMesh brick_for_benchmark(int n) {
-  HexMesh m;
-  const int32_t p = n + 1;
-  m.points.reserve(static_cast<size_t>(p) * p * p);
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.points.emplace_back(i, j, k);
-  auto id = [&](int i, int j, int k) { return static_cast<int32_t>(i + p * (j + p * k)); };
-  m.hexes.reserve(static_cast<size_t>(n) * n * n);
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        m.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                           id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                           id(i, j + 1, k + 1)});
-  return m;
+  BrickParams p;
+  p.dims = {n, n, n};
+  p.size = {static_cast<double>(n), static_cast<double>(n), static_cast<double>(n)};
+  return generate_brick(p);
 }
 
 void set_counters(benchmark::State& state, const HexMesh& mesh) {

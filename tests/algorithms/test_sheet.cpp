@@ -14,6 +14,7 @@
 #include "mesh/generators.hpp"
 #include "mesh/hex_convention.hpp"
 #include "mesh/topology.hpp"
+#include "tests/algorithms/refiner_suite.hpp"
 #include "tests/fixtures.hpp"
 
 namespace hexrefine {
@@ -169,6 +170,16 @@ TEST(SheetMark, LShapedCaseGrowsToTheWholeBrick) {
   const SheetMarking mk = sheet_mark(m, t, targets);
   EXPECT_EQ(mk.added_targets, 810);
   EXPECT_EQ(std::count(mk.hex_target.begin(), mk.hex_target.end(), 1), 1000);
+}
+
+TEST(SheetRefine, SharedRefinerSuite) {
+  const std::vector<int64_t> sizes =
+      refiner_suite_run([](const HexMesh& m, const Targets& t, const RefineOptions& o) {
+        return sheet_refine(m, t, o);
+      });
+  ASSERT_EQ(sizes.size(), 6u);
+  EXPECT_EQ(sizes[2], 27000);  // L-shaped: grown to the whole brick (thesis G-1)
+  EXPECT_EQ(sizes[4], 55272);  // gear teeth: the selective refiner's count (thesis H-1)
 }
 
 TEST(SheetRefine, RejectsInvalidTargets) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -62,6 +63,13 @@ TEST(CliRun, ResumeOfAFinishedRunRunsNothing) {
   EXPECT_EQ(ss.str(), done);
 }
 
+TEST(CliReproduce, RefusesStrayArguments) {
+  const CliRun r = cli_run("reproduce fast");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("unexpected argument 'fast'"), std::string::npos) << r.output;
+  EXPECT_EQ(cli_run("reproduce --fast").exit_code, 2);
+}
+
 TEST(CliMerge, JoinsShardsDeduplicatedInCaseOrder) {
   const auto dir = test_temp_dir("cli_merge");
   file_put(dir / "s2.jsonl",
@@ -91,6 +99,128 @@ TEST(CliMerge, JoinsShardsDeduplicatedInCaseOrder) {
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.output.find("bad.jsonl:1: not a JSON record"), std::string::npos) << bad.output;
   EXPECT_FALSE(fs::exists(dir / "x.jsonl"));
+}
+
+}  // namespace
+}  // namespace hexrefine
+
+namespace hexrefine {
+namespace {
+
+std::string file_read(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(CliRun, RunsBothMethodsOnTheSameTargetsAndChecksTheOutputs) {
+  const auto dir = test_temp_dir("cli_run_real");
+  const std::string abaqus = shared_mesh("abaqus_hex_2x2x2.inp");
+  file_put(dir / "c.json", R"({"cases":[
+    {"name":"full","mesh":{"generate":"brick","dims":[3,3,3]},"select":["all"],"save_mesh":true},
+    {"name":"inp","mesh":{"file":")" +
+                               abaqus + R"("},"select":["all"],"methods":["selective"]},
+    {"name":"bad-spec","mesh":{"generate":"brick","dims":[2,2,2]},"select":["boxx:1"],
+     "methods":["sheet"]}],
+    "output":"r.jsonl"})");
+  const CliRun r = cli_run("run " + (dir / "c.json").string());
+  // The malformed spec is bad input: recorded, the run goes on, and it exits 2 at the end.
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("4 records written (0 already present, 1 with an error)"),
+            std::string::npos)
+      << r.output;
+  const JsonlContent c = jsonl_read((dir / "r.jsonl").string());
+  ASSERT_EQ(c.records.size(), 4u);
+  for (int i = 0; i < 2; ++i) {
+    const json& full = c.records[i];
+    EXPECT_EQ(full["method"], i == 0 ? "selective" : "sheet");
+    EXPECT_FALSE(full.contains("error")) << full.dump();
+    EXPECT_EQ(full["initial_hexes"], 27);
+    EXPECT_EQ(full["selection"]["hexes"], 27);
+    EXPECT_EQ(full["final_hexes"], 729);
+    EXPECT_EQ(full["final_nodes"], 1000);
+    EXPECT_EQ(full["conformal"], true);
+    EXPECT_EQ(full["inverted_hexes"], 0);
+    EXPECT_DOUBLE_EQ(full["min_scaled_jacobian"].get<double>(), 1.0);
+    EXPECT_EQ(full["scaled_jacobian_histogram"]["counts"][19], 729);
+    EXPECT_EQ(full["input"]["generate"], "brick");
+    EXPECT_EQ(full["input"]["dims"], json({3, 3, 3}));
+    EXPECT_TRUE(fs::exists(dir / "r.meshes" / run_mesh_file_name("full", full["method"])));
+  }
+  const json& inp = c.records[2];
+  EXPECT_EQ(inp["final_hexes"], 216);
+  EXPECT_EQ(inp["input"]["sha256"], sha256_hex(file_read(abaqus)));
+  EXPECT_EQ(inp["conformal"], true);
+  const json& bad = c.records[3];
+  EXPECT_EQ(bad["error_kind"], "input");
+  EXPECT_NE(bad["error"].get<std::string>().find("boxx"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hexrefine
+
+namespace hexrefine {
+namespace {
+
+/// Runs experiments/plots.py (matplotlib is a CI dependency, .ci/setup.sh).
+CliRun plots_py(const std::string& args) {
+  const std::string cmd = std::string("/usr/bin/python3 ") + HEXREFINE_SOURCE_DIR +
+                          "/experiments/plots.py " + args + " 2>&1";
+  CliRun r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+TEST(PlotsPy, PutsOursBesideTheThesisWithRatios) {
+  const auto dir = test_temp_dir("plots_py");
+  auto g1 = [](const std::string& method, int final_hexes, double seconds, double min_sj) {
+    json r = record("G-1", 0, method, method == "selective" ? 0 : 1);
+    r["tags"] = {{"table", "G-1"}};
+    r["initial_hexes"] = 1000;
+    r["final_hexes"] = final_hexes;
+    r["time_seconds"] = seconds;
+    r["min_scaled_jacobian"] = min_sj;
+    r["input"] = {{"generate", "brick"}, {"initial_min_scaled_jacobian", 1.0}};
+    r["conformal"] = true;
+    r["inverted_hexes"] = 0;
+    return r;
+  };
+  json sweep = record("G-2/n=10", 1, "sheet", 1);
+  sweep["tags"] = {{"table", "G-2"}, {"n", 10}};
+  sweep["initial_hexes"] = 1000;
+  sweep["error"] = "sheet refinement refused";
+  file_put(dir / "r.jsonl", g1("selective", 8060, 0.0797, 0.3077).dump() + "\n" +
+                                g1("sheet", 27000, 3.242, 1.0).dump() + "\n" + sweep.dump() + "\n");
+  const std::string thesis = std::string(HEXREFINE_SHARED_DIR) + "/thesis/tables.json";
+  const CliRun r = plots_py((dir / "r.jsonl").string() + " --thesis " + thesis + " --out " +
+                            (dir / "out").string() + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir / "out" / "tables.md");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string md = ss.str();
+  // Thesis G-1: sheet 27,000 hexes in 6.484 s, selective 8,060 in 0.797 s (ratios ours/thesis).
+  EXPECT_NE(md.find("| Final element count | 27,000 | 27,000 | 1 | 8,060 | 8,060 | 1 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| Time (s) | 6.484 | 3.242 | 0.5 | 0.797 | 0.0797 | 0.1 |"), std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| 10 | 1,000 | 0.27 | – | – | – | 1 | – | – | – |"), std::string::npos) << md;
+  EXPECT_NE(md.find("error: sheet refinement refused"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "out" / "plots" / "G-2_time.png"));
+
+  file_put(dir / "bad.jsonl", "nonsense\n{}\n");
+  const CliRun bad = plots_py((dir / "bad.jsonl").string() + " --thesis " + thesis + " --out " +
+                              (dir / "out").string());
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.output.find("bad.jsonl:1: not a JSON record"), std::string::npos) << bad.output;
 }
 
 }  // namespace

@@ -13,11 +13,10 @@ TEST(CliSheets, AbaqusBrickHasSixSheets) {
   const auto dir = test_temp_dir("cli_sheets_abaqus");
   const std::string report = (dir / "sheets.json").string();
   const CliRun r = cli_run("sheets " + shared_mesh("abaqus_hex_2x2x2.inp") + " --report " + report);
-  // The Abaqus reader lands separately (branch io); until then mesh_read says so.
-  if (r.exit_code == 2 && r.output.find("not implemented") != std::string::npos)
-    GTEST_SKIP() << "Abaqus reader not available yet: " << r.output;
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("sheets: 6 (self-intersecting 0, closed 0)"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("(8 hexes, 27 nodes, 54 edges, 36 faces)"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("6 sheets of 4 hexes"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("chords: 12 (closed 0)"), std::string::npos) << r.output;

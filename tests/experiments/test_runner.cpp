@@ -47,14 +47,17 @@ json brick_case(const std::string& name) {
       {"name", name}, {"mesh", {{"generate", "brick"}, {"dims", {2, 2, 2}}}}, {"select", {"all"}}};
 }
 
+/// "c0", "c1", ... (built with += : "c" + std::to_string trips GCC 12's -Wrestrict false positive)
+std::string fake_case_name(int i) {
+  std::string name = "c";
+  name += std::to_string(i);
+  return name;
+}
+
 /// A plan of `n` cases "c0".."c{n-1}", both methods, built in memory.
 RunPlan fake_plan(int n, const std::string& output) {
   json cases = json::array();
-  for (int i = 0; i < n; ++i) {
-    std::string name = "c";
-    name += std::to_string(i);  // (not "c" + to_string: GCC 12 -Wrestrict false positive)
-    cases.push_back(brick_case(name));
-  }
+  for (int i = 0; i < n; ++i) cases.push_back(brick_case(fake_case_name(i)));
   RunPlan plan = run_plan_parse(json{{"cases", cases}}, "mem.json", "/nonexistent");
   plan.output = output;
   return plan;
@@ -111,6 +114,7 @@ TEST(RunPlan, ParsesDefaultsAndResolvesRelativePaths) {
                         {"methods", {"sheet"}},
                         {"passes", 3},
                         {"smooth", true},
+                        {"save_mesh", true},
                         {"options", {{"buffer", true}, {"ranking", false}}},
                         {"tags", {{"table", "X"}}}}}},
                      {"output", "out/r.jsonl"}};
@@ -131,6 +135,8 @@ TEST(RunPlan, ParsesDefaultsAndResolvesRelativePaths) {
   EXPECT_TRUE(b.options.buffer);
   EXPECT_FALSE(b.options.ranking);
   EXPECT_TRUE(b.smooth);
+  EXPECT_TRUE(b.save_mesh);
+  EXPECT_FALSE(a.save_mesh);
   EXPECT_EQ(b.tags["table"], "X");
   EXPECT_EQ(plan.output, (dir / "out" / "r.jsonl").string());
   // Without "output": beside the case file, named after it.
@@ -216,7 +222,7 @@ TEST(Jsonl, AppendsAndReadsBack) {
   const std::string path = (dir / "r.jsonl").string();
   EXPECT_TRUE(jsonl_read(path).records.empty());  // missing file: no records
   for (int i = 0; i < 3; ++i)
-    jsonl_append(path, json{{"case", "c" + std::to_string(i)},
+    jsonl_append(path, json{{"case", fake_case_name(i)},
                             {"method", "sheet"},
                             {"options", json::object()},
                             {"value", i}});
@@ -243,6 +249,8 @@ TEST(Jsonl, DropsTruncatedLastLineOnly) {
   EXPECT_EQ(c.records.size(), 1u);
   EXPECT_TRUE(c.truncated_tail);
   // A bad line in the middle is bad input, named by line.
+  file_put(path, good + "garbage\n");
+  EXPECT_EQ(input_error_of([&] { jsonl_read(path); }), path + ":2: not a JSON record");
   file_put(path, good + "garbage\n" + good);
   EXPECT_EQ(input_error_of([&] { jsonl_read(path); }), path + ":2: not a JSON record");
   file_put(path, good + "{\"case\":\"a\"}\n");
@@ -269,6 +277,7 @@ TEST(RunPlanExecute, WritesOneRecordPerCaseAndMethod) {
   EXPECT_EQ(records[4]["final_hexes"], 81);
   EXPECT_EQ(records[5]["final_hexes"], 102);
   EXPECT_EQ(records[0]["commit"], "abc123");
+  EXPECT_EQ(records[0]["commit_dirty"], false);
   EXPECT_EQ(records[0]["machine"]["cpu"], "test cpu");
   EXPECT_EQ(records[0]["machine"]["cores"], 2);
   EXPECT_EQ(records[0]["build_type"], "release");
@@ -277,6 +286,21 @@ TEST(RunPlanExecute, WritesOneRecordPerCaseAndMethod) {
   // A second run without --resume starts the file over.
   run_plan_execute(plan, quiet_settings(), std::ref(fake));
   EXPECT_EQ(jsonl_read(out).records.size(), 6u);
+}
+
+TEST(RunPlanExecute, ReportsProgressCaseByCase) {
+  const auto dir = test_temp_dir("runner_progress");
+  const RunPlan plan = fake_plan(3, (dir / "r.jsonl").string());
+  std::ostringstream progress;
+  RunSettings settings = quiet_settings();
+  settings.progress = &progress;
+  FakeExecutor fake;
+  run_plan_execute(plan, settings, std::ref(fake));
+  const std::string text = progress.str();
+  EXPECT_EQ(text.rfind("[case 1 of 3] c0 (2 methods)  elapsed ", 0), 0u) << text;
+  EXPECT_NE(text.find("[case 3 of 3] c2 (2 methods)"), std::string::npos) << text;
+  EXPECT_NE(text.find(" s left"), std::string::npos) << text;  // an estimate once one case is done
+  EXPECT_NE(text.find("done: 6 records in "), std::string::npos) << text;
 }
 
 TEST(RunPlanExecute, ResumeAfterKilledRunLosesNothingAndRepeatsNothing) {
@@ -370,7 +394,7 @@ TEST(RunShard, ShardsPartitionTheCasesAndMergeRestoresTheOrder) {
   EXPECT_EQ(parts[1].size(), 4u);  // cases 1, 4
   EXPECT_EQ(parts[2].size(), 4u);  // cases 2, 5
   EXPECT_EQ(cases_run.size(), 14u);
-  for (int i = 0; i < 7; ++i) EXPECT_EQ(cases_run.count("c" + std::to_string(i)), 2u);
+  for (int i = 0; i < 7; ++i) EXPECT_EQ(cases_run.count(fake_case_name(i)), 2u);
 
   // Merge in the wrong order, with a duplicate: case order restored, one record per key.
   std::vector<std::vector<json>> inputs = {parts[2], parts[0], parts[1], {parts[0][2]}};
@@ -385,6 +409,20 @@ TEST(RunShard, ShardsPartitionTheCasesAndMergeRestoresTheOrder) {
   EXPECT_EQ(merged[6]["final_hexes"], -7);
   jsonl_write((dir / "merged.jsonl").string(), merged);
   EXPECT_EQ(jsonl_read((dir / "merged.jsonl").string()).records, merged);
+}
+
+TEST(RunEnvironment, DetectsCommitMachineAndBuild) {
+  const RunEnvironment env = run_environment_detect();
+  // The tests run from a git checkout of the source tree.
+  EXPECT_EQ(env.commit.size(), 40u) << env.commit;
+  EXPECT_GE(env.cores, 1);
+  EXPECT_FALSE(env.cpu.empty());
+  EXPECT_TRUE(env.build_type == "release" || env.build_type == "debug");
+}
+
+TEST(RunMeshFileName, ReplacesPathCharacters) {
+  EXPECT_EQ(run_mesh_file_name("G-3/n=20", "selective"), "G-3_n=20.selective.vtu");
+  EXPECT_EQ(run_mesh_file_name("a b:c", "sheet"), "a_b_c.sheet.vtu");
 }
 
 TEST(ScaledJacobianHistogram, FixedBins) {
@@ -425,6 +463,9 @@ TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
     EXPECT_EQ(g2, static_cast<int>(sweep));
     EXPECT_EQ(ablations, 6);
     EXPECT_EQ(plan.cases[0].name, "G-1");
+    EXPECT_TRUE(plan.cases[0].save_mesh);
+    EXPECT_EQ(plan.cases[1].name, "6-1");
+    EXPECT_TRUE(plan.cases[1].save_mesh);
     EXPECT_EQ(plan.cases[0].mesh["dims"], json({10, 10, 10}));
     EXPECT_EQ(plan.cases[0].select,
               (std::vector<std::string>{"boundary:-1,0,0", "boundary:0,0,-1"}));

@@ -30,8 +30,17 @@
 ///     subdivide shared faces identically.
 ///  6. Every node is keyed by what it subdivides (TemplateRefiner), so the element-by-element
 ///     templates and the directional cells share nodes on common edges and faces.
+///  7. Self-check (never return a broken mesh): every output face is used by at most two hexes,
+///     every output boundary face lies on one input boundary face, no child of a valid input hex
+///     is inverted. Directions follow sheets: a child's local axis belongs to the parent sheet it
+///     continues (HexTemplate::child_axis), not to the closest geometric axis.
+/// Where the directional scheme meets a doublet it can only avoid by splitting an input edge, or
+/// a distorted hex whose element-by-element children would be inverted, the pass starts again
+/// with that edge split / that hex refined directionally (each attempt changes one more edge or
+/// hex, so this ends). What still fails throws OperationError naming the input hexes.
 /// Cost: marking, worklists and ranking touch only the hexes around split edges; each cell is
-/// refined once per direction; the only whole-mesh work is building the topology and copying.
+/// refined once per direction; the whole-mesh work is building the topology, copying, and the
+/// self-check, once per attempt (further attempts are rare: only configurations that need them).
 
 #include "algorithms/selective.hpp"
 
@@ -188,6 +197,12 @@ struct InputEdgeSplitNeeded {
   int32_t edge;
 };
 
+// Thrown when element-by-element templates would invert children of these (distorted) input
+// hexes: the pass starts again refining them directionally, whose children differ.
+struct DirectionalFallbackNeeded {
+  std::vector<int32_t> hexes;
+};
+
 struct PassOutput {
   HexMesh mesh;
   std::vector<int32_t> parent;
@@ -199,12 +214,14 @@ class SelectivePass {
   /// `forced_splits`: input edges split from the outset (found by earlier attempts).
   SelectivePass(const HexMesh& mesh, const std::vector<int32_t>& targets,
                 const RefineOptions& options, RefineStats& stats,
-                const std::vector<int32_t>& forced_splits)
+                const std::vector<int32_t>& forced_splits,
+                const std::vector<uint8_t>& forced_directional)
       : mesh_(mesh),
         targets_(targets),
         options_(options),
         stats_(stats),
-        forced_splits_(forced_splits) {}
+        forced_splits_(forced_splits),
+        forced_directional_(forced_directional) {}
 
   PassOutput run();
 
@@ -236,12 +253,16 @@ class SelectivePass {
   void register_adjustments(const TemplateCell& cell, const TemplateChoice& c);
   void apply(const Decision& d, std::vector<TemplateCell>& next);
   void check_output(const PassOutput& out) const;
+  /// A hex with split mask `mask` is refined directionally: no template matches, or it was forced
+  /// (its element-by-element children would invert).
+  bool is_directional(int32_t h, uint16_t mask) const;
 
   const HexMesh& mesh_;
   const std::vector<int32_t>& targets_;
   const RefineOptions& options_;
   RefineStats& stats_;
   const std::vector<int32_t>& forced_splits_;
+  const std::vector<uint8_t>& forced_directional_;  // per input hex (empty: none)
   HexTopology topo_;
   std::unique_ptr<TemplateRefiner> refiner_;
   std::vector<uint8_t> split_;  // per input edge
@@ -285,6 +306,12 @@ void SelectivePass::mark() {
   std::sort(touched_.begin(), touched_.end());
 }
 
+bool SelectivePass::is_directional(int32_t h, uint16_t mask) const {
+  const TemplateChoice c = template_for_mask(mask);
+  if (!c.tmpl) return true;
+  return c.tmpl != &template_1_27() && !forced_directional_.empty() && forced_directional_[h];
+}
+
 void SelectivePass::resolve_doublets() {
   // Worklist: hexes whose split mask changed. An edge is bad for an adjustment if fewer than
   // four faces meet there (the two neighbours would share two faces, Appendix F), if one of the
@@ -305,7 +332,7 @@ void SelectivePass::resolve_doublets() {
     for (int32_t h : touched_) {
       const uint16_t mask = hex_split_mask(topo_, split_, h);
       if (!mask) continue;
-      const bool directional = !template_for_mask(mask).tmpl;
+      const bool directional = is_directional(h, mask);
       std::array<int, 12> adj{};
       const int n = adjustment_edges(mask, directional, adj);
       for (int i = 0; i < n; ++i) {
@@ -319,7 +346,7 @@ void SelectivePass::resolve_doublets() {
           const int32_t n = hex_face_neighbor(topo_, h, lf);
           if (n >= 0 && role_[n] != kTarget) {
             const uint16_t nm = hex_split_mask(topo_, split_, n);
-            bad = bad || (nm && !template_for_mask(nm).tmpl);
+            bad = bad || (nm && is_directional(n, nm));
           }
         }
         if (adjusting_hex[e] >= 0 && adjusting_hex[e] != h) bad = true;
@@ -351,7 +378,9 @@ void SelectivePass::choose() {
   for (int32_t h : touched_) {
     const uint16_t mask = hex_split_mask(topo_, split_, h);
     if (!mask) continue;
-    const TemplateChoice c = template_for_mask(mask);
+    TemplateChoice c = template_for_mask(mask);
+    // 1-27 stays (its children cannot invert in a valid hex); others may be forced directional.
+    if (is_directional(h, mask)) c = {};
     if (c.tmpl) {
       role_[h] = kElement;
       element_choice_[h] = c;
@@ -799,6 +828,12 @@ void SelectivePass::check_output(const PassOutput& out) const {
   if (!bad_parents.empty())
     throw OperationError("selective_refine: cannot refine this configuration conformally; " +
                          listed(bad_parents));
+  if (!inverted_parents.empty()) {
+    std::vector<int32_t> element;
+    for (int32_t h : inverted_parents)
+      if (role_[h] == kElement && element_choice_[h].tmpl != &template_1_27()) element.push_back(h);
+    if (!element.empty()) throw DirectionalFallbackNeeded{element};
+  }
   if (!inverted_parents.empty())
     throw OperationError(
         "selective_refine: the templates would invert hexes here (the input "
@@ -921,13 +956,27 @@ RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
     // A pass that meets an adjustment it can only avoid by splitting an input edge starts
     // again with that edge split (each attempt splits one more edge, so this ends).
     std::vector<int32_t> forced;
+    std::vector<uint8_t> forced_directional;
     PassOutput out;
     const RefineStats before = stats;
     for (;;) {
       try {
-        SelectivePass p(current, current_targets, options, stats, forced);
+        SelectivePass p(current, current_targets, options, stats, forced, forced_directional);
         out = p.run();
         break;
+      } catch (const DirectionalFallbackNeeded& need) {
+        // Distorted hexes whose element-by-element children would invert: refine them
+        // directionally instead (each attempt forces at least one more hex, so this ends).
+        if (forced_directional.empty()) forced_directional.assign(current.hex_count(), 0);
+        bool progress = false;
+        for (int32_t h : need.hexes) {
+          progress = progress || !forced_directional[h];
+          forced_directional[h] = 1;
+        }
+        if (!progress) throw OperationError("selective_refine: directional fallback failed");
+        const auto phases = stats.phase_seconds;
+        stats = before;
+        stats.phase_seconds = phases;
       } catch (const InputEdgeSplitNeeded& need) {
         if (need.edge < 0 || std::find(forced.begin(), forced.end(), need.edge) != forced.end())
           throw OperationError("selective_refine: cannot avoid a doublet at input edge " +

@@ -4,23 +4,24 @@
 ///
 /// A template is a list of nodes given by their position in the reference cube [0,1]^3 (canonical
 /// orientation, mesh/hex_convention.hpp) and a list of child hexes over those nodes. To apply it
-/// to a hex, a cube symmetry maps the canonical reference cube onto the hex's local frame; each
-/// template node is then classified by where its mapped position lies:
-///  - at a corner: the parent's node;
-///  - inside an edge: keyed by (edge id, position along the edge in the edge's global direction,
-///    lower node id -> higher node id, in sixths);
-///  - inside a face: keyed by (face id, position in the face's canonical frame, in sixths): the
-///  frame
-///    starts at the face's lowest node id and runs towards its lower-id neighbour;
-///  - inside the hex: a new node of this hex only;
-///  - an *adjustment* node (explicitly marked): keyed by (edge id, index) of the unsplit edge it
-///    collapses faces at (Parrish, Appendix E: 1-3 with one / two adjustments). Faces of
-///    neighbouring hexes whose face-template nodes are collapsed onto that edge name the same key
-///    through TemplateFaceAlias.
-/// Because every hex derives the same key for the same edge/face position, neighbours share nodes
-/// and conformity holds by construction. The first hex to create a node sets its position from
-/// its own trilinear map; for straight-edged hexes and planar (bilinear) faces both sides compute
-/// the same point up to rounding.
+/// to a cell (an input hex, or a sub-hex of one made by earlier directional steps), a cube
+/// symmetry maps the canonical cube onto the cell's local frame and the cell's corners map that
+/// onto exact positions (integers over template_param_unit) in the input hex's reference cube.
+/// Each template node is then keyed by where that position lies in the input hex:
+///  - at a corner: the input node;
+///  - inside an edge: (edge id, position along the edge, lower node id -> higher node id);
+///  - inside a face: (face id, position in the face's canonical frame: origin at the face's
+///    lowest node id, u towards its lower-id neighbour);
+///  - inside the hex: (hex id, position), shared by the sub-hexes of that hex;
+///  - an *adjustment* node (explicitly marked): (edge id, index) of the unsplit edge it collapses
+///    faces at (Parrish, Appendix E: 1-3 with one / two adjustments), or its position in the hex
+///    when cells are refined again (TemplateRefiner::set_adjustment_keys_by_position). Faces of
+///    neighbouring hexes whose face-template nodes are collapsed onto it name it through an
+///    alias (TemplateFaceAlias, TemplateRefiner::alias).
+/// Because every cell derives the same key for the same edge/face position, neighbours share
+/// nodes and conformity holds by construction. Nodes are positioned by the input hex's trilinear
+/// map at their exact position; on a shared face both hexes' maps agree (the bilinear face map).
+/// Keys live in one hash table (TemplateRefiner): O(1) per node, no node-pair map.
 
 #include <array>
 #include <cstdint>

@@ -199,6 +199,28 @@ TEST(Templates, MaskTableCoversTheSevenPatternsUnderAllSymmetries) {
   EXPECT_EQ(template_for_mask(0).tmpl, nullptr);
 }
 
+TEST(Templates, ChildDirectionsFollowSheets) {
+  // 1-3: every slab keeps the cube's axes.
+  for (const auto& a : template_1_3().child_axis) EXPECT_EQ(a, (std::array<int8_t, 3>{0, 1, 2}));
+  // 1-4 (x-edges of face y=0 split): the top child (Q1 Q2 C D) has two directions on x sheets
+  // (the split edge's sheet turns round it) and none on the y sheet; the others keep x, y, z.
+  const HexTemplate& t = template_1_4();
+  int without_y = 0;
+  for (size_t c = 0; c < t.children.size(); ++c) {
+    const auto& a = t.child_axis[c];
+    EXPECT_EQ(a[2], 2);
+    const bool has_y = a[0] == 1 || a[1] == 1;
+    if (!has_y) {
+      ++without_y;
+      EXPECT_EQ(a[0], 0);
+      EXPECT_EQ(a[1], 0);
+    }
+  }
+  EXPECT_EQ(without_y, 1);
+  for (const HexTemplate* tp : {&template_1_5(), &template_1_3_adjust1(), &template_1_3_adjust2()})
+    EXPECT_EQ(tp->child_axis.size(), tp->children.size());
+}
+
 TEST(Templates, ValidateRejectsAnInvertedChild) {
   HexTemplate t = template_1_3();
   std::swap(t.children[1][0], t.children[1][1]);

@@ -1,8 +1,11 @@
 #include "mesh/io.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -138,19 +141,64 @@ HexMesh mesh_read(const std::string& path) {
     throw InputError(path + ": is a folder, expected a mesh file");
   switch (format) {
     case MeshFormat::medit:
-      return io_detail::medit_read(path);
+      return io_detail::medit_read(path, io_detail::file_read_all(path));
     case MeshFormat::vtk_legacy:
-      return io_detail::vtk_read(path);
+      return io_detail::vtk_read(path, io_detail::file_read_all(path));
     case MeshFormat::vtu:
-      return io_detail::vtu_read(path);
+      return io_detail::vtu_read(path, io_detail::file_read_all(path));
     case MeshFormat::gmsh:
-      return io_detail::gmsh_read(path);
+      return io_detail::gmsh_read(path, io_detail::file_read_all(path));
     case MeshFormat::exodus:
       return io_detail::exodus_read(path);
     case MeshFormat::abaqus:
-      return io_detail::abaqus_read(path);
+      return io_detail::abaqus_read(path, io_detail::file_read_all(path));
   }
   throw InputError(path + ": unknown mesh format");
+}
+
+HexMesh mesh_read_from_memory(const std::string& name, std::string_view bytes) {
+  const MeshFormat format = mesh_format_of(name);
+  if (format == MeshFormat::exodus) {
+    // libexodusii opens files by name only; mkstemps gives a fresh private file.
+    std::string tmp =
+        (std::filesystem::temp_directory_path() / "hexrefine_memory_XXXXXX.e").string();
+    const int fd = ::mkstemps(tmp.data(), 2);
+    if (fd < 0) throw OperationError(name + ": cannot create a temporary file to read Exodus II");
+    ::close(fd);
+    struct Remove {
+      std::string path;
+      ~Remove() { std::remove(path.c_str()); }
+    } remove_tmp{tmp};
+    {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      if (!out) throw OperationError(name + ": cannot write a temporary file to read Exodus II");
+    }
+    try {
+      return io_detail::exodus_read(tmp);
+    } catch (const InputError& e) {
+      // Name the caller's source, not the temporary file.
+      std::string message = e.what();
+      if (message.rfind(tmp, 0) == 0) message = name + message.substr(tmp.size());
+      throw InputError(message);
+    }
+  }
+  const std::string text(bytes);
+  switch (format) {
+    case MeshFormat::medit:
+      return io_detail::medit_read(name, text);
+    case MeshFormat::vtk_legacy:
+      return io_detail::vtk_read(name, text);
+    case MeshFormat::vtu:
+      return io_detail::vtu_read(name, text);
+    case MeshFormat::gmsh:
+      return io_detail::gmsh_read(name, text);
+    case MeshFormat::abaqus:
+      return io_detail::abaqus_read(name, text);
+    case MeshFormat::exodus:
+      break;
+  }
+  throw InputError(name + ": unknown mesh format");
 }
 
 void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOptions& options) {

@@ -37,6 +37,7 @@
 /// and names the file and line (or entity) in its InputError.
 
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -60,6 +61,12 @@ struct MeshWriteOptions {
 /// Reads a hex mesh; the format follows from the extension. Throws InputError
 /// "path:line: what was expected" on bad input.
 HexMesh mesh_read(const std::string& path);
+
+/// Reads a hex mesh from the bytes of a file held in memory (fuzzing, tests, data received by
+/// other means). `name` gives the format by its extension (as mesh_read) and names the source in
+/// messages; the checks are those of mesh_read. Exodus II needs a file for its library: the bytes
+/// are written to a temporary file in the system temp folder, read and removed.
+HexMesh mesh_read_from_memory(const std::string& name, std::string_view bytes);
 
 /// Writes `mesh` atomically (temporary file + rename). Throws InputError for a mesh the format
 /// cannot hold (e.g. a bad attribute name), OperationError if the file cannot be written.

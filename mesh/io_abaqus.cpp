@@ -85,8 +85,7 @@ struct AbaqusSet {
 
 }  // namespace
 
-HexMesh abaqus_read(const std::string& path) {
-  const std::string text = file_read_all(path);
+HexMesh abaqus_read(const std::string& path, const std::string& text) {
   TextCursor in(path, text);
   HexMesh mesh;
   std::vector<int64_t> node_ids, node_lines;
@@ -97,6 +96,8 @@ HexMesh abaqus_read(const std::string& path) {
   enum class Mode { skip, node, hex, other_element, elset } mode = Mode::skip;
   int32_t current_block = 0;
   bool generate = false;
+  int64_t generated = 0;  // ids listed by GENERATE rows so far
+  const int64_t generate_limit = 4 * static_cast<int64_t>(text.size()) + 1024;
   bool saw_keyword = false;
   while (in.remaining() > 0) {
     const int64_t line_no = in.line();
@@ -195,6 +196,15 @@ HexMesh abaqus_read(const std::string& path) {
         const int64_t step = f.size() == 3 ? integer(f[2], "step") : 1;
         if (step < 1 || b < a || (b - a) / step > static_cast<int64_t>(text.size()))
           throw InputError(error_at(path, line_no, "bad ELSET GENERATE range"));
+        // Every id must name a hex row of the file, so all sets together cannot sensibly list
+        // more ids than a few per byte; without this bound many short GENERATE rows would
+        // allocate quadratically in the file size.
+        generated += (b - a) / step + 1;
+        if (generated > generate_limit)
+          throw InputError(error_at(path, line_no,
+                                    "ELSET GENERATE rows list " + std::to_string(generated) +
+                                        " element ids, more than the file (" +
+                                        std::to_string(text.size()) + " bytes) can define"));
         for (int64_t e = a; e <= b; e += step)
           s.element_ids.push_back(e), s.lines.push_back(line_no);
       } else {

@@ -38,6 +38,128 @@ std::string upper(const char* s) {
   return u;
 }
 
+/// Walks the header of a netCDF classic file (CDF-1, CDF-2 or CDF-5: magic, record count, then
+/// the dimension, global attribute and variable lists, each "tag, count, entries") and checks
+/// every count and length against the bytes that follow, so the netCDF library, which allocates
+/// whatever its header claims (a name length of 1.4 GB was found by fuzzing), only ever sees
+/// headers the file can hold. `bytes` is the start of the file (at least the whole header, or
+/// the whole file); returns false when the header runs past `bytes` but not past `file_size`
+/// (the caller reads more), throws InputError naming `path` when it is malformed.
+bool netcdf_classic_header_check(const std::string& path, std::string_view bytes,
+                                 int64_t file_size) {
+  const int version = bytes[3];
+  const size_t count_size = version == 5 ? 8 : 4;  // NON_NEG: nelems, lengths, dimids
+  size_t pos = 4;
+  bool truncated = false;
+  auto fail = [&](const std::string& what) {
+    throw InputError(path + ": not a valid netCDF header (" + what + " at byte " +
+                     std::to_string(pos) + ")");
+  };
+  auto need = [&](uint64_t n) {
+    if (n > bytes.size() - pos) {
+      if (static_cast<int64_t>(bytes.size()) < file_size) truncated = true;
+      return false;
+    }
+    return true;
+  };
+  auto number = [&](size_t size, const char* what) -> uint64_t {
+    if (!need(size)) {
+      if (truncated) return 0;
+      fail(std::string("file ends inside ") + what);
+    }
+    uint64_t v = 0;
+    for (size_t i = 0; i < size; ++i) v = (v << 8) | static_cast<unsigned char>(bytes[pos + i]);
+    pos += size;
+    return v;
+  };
+  // A count of items needing at least `min_each` bytes each in what is left of the file.
+  auto count = [&](const char* what, uint64_t min_each) -> uint64_t {
+    const uint64_t n = number(count_size, what);
+    if (truncated) return 0;
+    if (count_size == 4 && n > INT32_MAX) fail(std::string("negative ") + what);
+    if (n > static_cast<uint64_t>(file_size - static_cast<int64_t>(pos)) / min_each)
+      fail(std::string(what) + " " + std::to_string(n) + " larger than the file can hold");
+    return n;
+  };
+  auto skip_padded = [&](uint64_t n, const char* what) {
+    const uint64_t padded = (n + 3) / 4 * 4;
+    if (padded > static_cast<uint64_t>(file_size - static_cast<int64_t>(pos)))
+      fail(std::string(what) + " of " + std::to_string(n) + " bytes larger than the file");
+    if (!need(padded)) return;
+    pos += static_cast<size_t>(padded);
+  };
+  auto name = [&] {
+    const uint64_t n = count("name length", 1);
+    if (truncated) return;
+    if (n > 4096) fail("name of " + std::to_string(n) + " bytes");
+    skip_padded(n, "name");
+  };
+  auto type_size = [&](uint64_t type) -> uint64_t {
+    switch (type) {
+      case 1:
+      case 2:
+      case 7:
+        return 1;  // byte, char, ubyte
+      case 3:
+      case 8:
+        return 2;  // short, ushort
+      case 4:
+      case 5:
+      case 9:
+        return 4;  // int, float, uint
+      case 6:
+      case 10:
+      case 11:
+        return 8;  // double, int64, uint64
+    }
+    fail("unknown data type " + std::to_string(type));
+    return 1;  // not reached: fail throws
+  };
+  auto attributes = [&] {
+    const uint64_t tag = number(4, "attribute list tag");
+    const uint64_t n = count("attribute count", 12);
+    if (truncated) return;
+    if (tag != 0x0C && !(tag == 0 && n == 0)) fail("bad attribute list tag");
+    for (uint64_t i = 0; i < n && !truncated; ++i) {
+      name();
+      const uint64_t type = number(4, "attribute type");
+      if (truncated) return;
+      const uint64_t size = type_size(type);
+      const uint64_t values = count("attribute value count", size);
+      if (truncated) return;
+      skip_padded(values * size, "attribute values");
+    }
+  };
+  number(count_size, "record count");
+  // Dimensions.
+  const uint64_t dim_tag = number(4, "dimension list tag");
+  const uint64_t dims = count("dimension count", 8);
+  if (!truncated && dim_tag != 0x0A && !(dim_tag == 0 && dims == 0)) fail("bad dimension list tag");
+  for (uint64_t i = 0; i < dims && !truncated; ++i) {
+    name();
+    number(count_size, "dimension length");
+  }
+  if (!truncated) attributes();
+  // Variables.
+  const uint64_t var_tag = number(4, "variable list tag");
+  const uint64_t vars = count("variable count", 24);
+  if (!truncated && var_tag != 0x0B && !(var_tag == 0 && vars == 0)) fail("bad variable list tag");
+  for (uint64_t i = 0; i < vars && !truncated; ++i) {
+    name();
+    const uint64_t rank = count("variable rank", count_size);
+    for (uint64_t k = 0; k < rank && !truncated; ++k)
+      if (number(count_size, "dimension id") >= dims && !truncated)
+        fail("dimension id out of range");
+    if (truncated) break;
+    attributes();
+    if (truncated) break;
+    type_size(number(4, "variable type"));
+    number(count_size, "variable size");
+    number(version == 1 ? 4 : 8, "variable offset");
+  }
+  return !truncated;
+}
+
 }  // namespace
 
 HexMesh exodus_read(const std::string& path) {
@@ -58,6 +180,17 @@ HexMesh exodus_read(const std::string& path) {
     if (!f || (!classic && !hdf5))
       throw InputError(path +
                        ": not an Exodus II file (expected a netCDF 'CDF' or HDF5 signature)");
+    if (classic) {
+      // The header is usually a few KB: check it from the first 1 MB, or the whole file if it
+      // is longer.
+      for (int64_t read = std::min<int64_t>(file_size, 1 << 20);; read = file_size) {
+        std::string head(static_cast<size_t>(read), '\0');
+        f.seekg(0);
+        f.read(head.data(), read);
+        if (!f) throw InputError(path + ": read failed");
+        if (netcdf_classic_header_check(path, head, file_size) || read == file_size) break;
+      }
+    }
   }
   ex_opts(EX_DEFAULT);  // report errors through return codes only; never abort
   int comp_ws = 8, io_ws = 0;

@@ -80,14 +80,14 @@ void gmsh_element_row(TextCursor& in, GmshRead& g, int64_t type, int64_t tag, in
 
 void gmsh_skip_section(TextCursor& in, std::string_view name) {
   const std::string end = "$End" + std::string(name.substr(1));
-  while (in.token("'" + end + "'") != end) {
+  const std::string expected = "'" + end + "'";
+  while (in.token(expected) != end) {
   }
 }
 
 }  // namespace
 
-HexMesh gmsh_read(const std::string& path) {
-  const std::string text = file_read_all(path);
+HexMesh gmsh_read(const std::string& path, const std::string& text) {
   TextCursor in(path, text);
   GmshRead g;
   in.expect("$MeshFormat");

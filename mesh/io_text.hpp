@@ -53,8 +53,10 @@ class TextCursor {
     skip_space();
     if (pos_ >= text_.size()) fail("unexpected end of file, expected " + what);
     const size_t start = pos_;
+    // comment_ == 0 means "no comment character": a NUL byte is then part of the token (which
+    // will not parse), never an empty token that would stall a caller's loop.
     while (pos_ < text_.size() && !is_space(text_[pos_]) && !is_extra(text_[pos_]) &&
-           text_[pos_] != comment_)
+           (comment_ == 0 || text_[pos_] != comment_))
       ++pos_;
     return text_.substr(start, pos_ - start);
   }
@@ -265,21 +267,22 @@ T read_big_endian(const char* p) {
   return v;
 }
 
-// Per-format entry points (io_<format>.cpp); mesh_read / mesh_write dispatch to them.
-HexMesh medit_read(const std::string& path);
+// Per-format entry points (io_<format>.cpp); mesh_read / mesh_write dispatch to them. The text
+// readers parse `text` (the file's bytes) and use `path` only in messages.
+HexMesh medit_read(const std::string& path, const std::string& text);
 void medit_write(const std::string& path, const HexMesh& mesh);
-HexMesh vtk_read(const std::string& path);
+HexMesh vtk_read(const std::string& path, const std::string& text);
 void vtk_write(const std::string& path, const HexMesh& mesh, const bool binary,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
-HexMesh vtu_read(const std::string& path);
+HexMesh vtu_read(const std::string& path, const std::string& text);
 void vtu_write(const std::string& path, const HexMesh& mesh,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
-HexMesh gmsh_read(const std::string& path);
+HexMesh gmsh_read(const std::string& path, const std::string& text);
 void gmsh_write(const std::string& path, const HexMesh& mesh,
                 const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
 HexMesh exodus_read(const std::string& path);
 void exodus_write(const std::string& path, const HexMesh& mesh);
-HexMesh abaqus_read(const std::string& path);
+HexMesh abaqus_read(const std::string& path, const std::string& text);
 void abaqus_write(const std::string& path, const HexMesh& mesh);
 
 /// Writers build text in a string and hand it to the stream in 64 KiB pieces (one write per

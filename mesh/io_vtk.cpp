@@ -253,8 +253,7 @@ void vtk_read_data_block(TextCursor& in, bool binary, VtkReadState& st, bool cel
 
 }  // namespace
 
-HexMesh vtk_read(const std::string& path) {
-  const std::string text = file_read_all(path);
+HexMesh vtk_read(const std::string& path, const std::string& text) {
   TextCursor in(path, text);
   const std::string_view first = in.rest_of_line();
   if (first.substr(0, 14) != "# vtk DataFile")
@@ -575,8 +574,7 @@ int64_t line_of(std::string_view text, size_t pos) {
 
 }  // namespace
 
-HexMesh vtu_read(const std::string& path) {
-  const std::string text = file_read_all(path);
+HexMesh vtu_read(const std::string& path, const std::string& text) {
   const std::string_view all(text);
   auto fail_at = [&](size_t pos, const std::string& message) -> void {
     throw InputError(error_at(path, line_of(all, pos), message));

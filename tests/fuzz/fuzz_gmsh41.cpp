@@ -1,0 +1,6 @@
+/// \file
+/// libFuzzer target: Gmsh, seeded with version 4.1 files. See fuzz_common.hpp and run_fuzzers.sh.
+
+#include "tests/fuzz/fuzz_common.hpp"
+
+HEXREFINE_FUZZ_TARGET("fuzz.msh")

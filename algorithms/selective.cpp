@@ -55,6 +55,7 @@
 #include "algorithms/templates.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
 #include "mesh/topology.hpp"
 
 namespace hexrefine {
@@ -67,19 +68,9 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// Corner-Jacobian inversion test of an input hex.
+// The checker's definition (mesh/conformity.hpp): inverted = scaled Jacobian <= 0.
 bool hex_is_inverted(const HexMesh& m, int32_t h) {
-  const auto x = hex_points(m, h);
-  for (int v = 0; v < 8; ++v) {
-    std::array<Eigen::Vector3d, 3> e;
-    for (int k = 0; k < 3; ++k) {
-      const int edge = hex_vertex_edges[v][k];
-      const int w = hex_edges[edge][0] == v ? hex_edges[edge][1] : hex_edges[edge][0];
-      e[k] = hex_corner[v][k] ? (x[v] - x[w]) : (x[w] - x[v]);
-    }
-    if (!(e[0].dot(e[1].cross(e[2])) > 0)) return true;
-  }
-  return false;
+  return hex_scaled_jacobian(hex_points(m, h)) <= 0.0;
 }
 
 enum Role : uint8_t { kUntouched = 0, kTarget = 1, kElement = 2, kDirectional = 3 };

@@ -5,6 +5,7 @@
 
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
 
 namespace hexrefine {
 
@@ -621,63 +622,6 @@ const HexTemplate& template_1_3() {
   return t;
 }
 
-}  // namespace hexrefine
-
-namespace hexrefine {
-
-namespace {
-
-// Scaled Jacobian of a hex (Knupp): the minimum over the 8 corners and the centre of the
-// determinant of the three unit edge (or principal axis) vectors. 1 for a cube, <= 0 inverted.
-double child_scaled_jacobian(const std::array<Eigen::Vector3d, 8>& x) {
-  double out = 2.0;
-  for (int v = 0; v < 8; ++v) {
-    std::array<Eigen::Vector3d, 3> e;
-    for (int k = 0; k < 3; ++k) {
-      const int edge = hex_vertex_edges[v][k];
-      const int w = hex_edges[edge][0] == v ? hex_edges[edge][1] : hex_edges[edge][0];
-      // Point along +axis so the triple product of a positive hex is positive.
-      e[k] = hex_corner[v][k] ? (x[v] - x[w]) : (x[w] - x[v]);
-      const double n = e[k].norm();
-      if (n == 0) return -1.0;
-      e[k] /= n;
-    }
-    out = std::min(out, e[0].dot(e[1].cross(e[2])));
-  }
-  std::array<Eigen::Vector3d, 3> a;
-  for (int k = 0; k < 3; ++k) {
-    a[k] = Eigen::Vector3d::Zero();
-    for (int v = 0; v < 8; ++v) a[k] += (hex_corner[v][k] ? 0.25 : -0.25) * x[v];
-    const double n = a[k].norm();
-    if (n == 0) return -1.0;
-    a[k] /= n;
-  }
-  return std::min(out, a[0].dot(a[1].cross(a[2])));
-}
-
-// Volume of a trilinear hex by 2x2x2 Gauss quadrature of its Jacobian determinant.
-double child_volume(const std::array<Eigen::Vector3d, 8>& x) {
-  const double g[2] = {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)};
-  double vol = 0;
-  for (double r : g)
-    for (double s : g)
-      for (double t : g) {
-        const double p[3] = {r, s, t};
-        Eigen::Matrix3d j = Eigen::Matrix3d::Zero();
-        for (int v = 0; v < 8; ++v)
-          for (int k = 0; k < 3; ++k) {
-            double w = hex_corner[v][k] ? 1.0 : -1.0;
-            for (int m = 0; m < 3; ++m)
-              if (m != k) w *= hex_corner[v][m] ? p[m] : 1.0 - p[m];
-            j.col(k) += w * x[v];
-          }
-        vol += j.determinant() / 8.0;
-      }
-  return vol;
-}
-
-}  // namespace
-
 double template_validate(const HexTemplate& tmpl) {
   auto fail = [&](const std::string& why) {
     throw OperationError(std::string("template ") + template_tag_name(tmpl.tag) + ": " + why);
@@ -690,10 +634,10 @@ double template_validate(const HexTemplate& tmpl) {
       const auto& r = tmpl.nodes.at(tmpl.children[c][k]).ref;
       x[k] = Eigen::Vector3d(r[0], r[1], r[2]);
     }
-    const double sj = child_scaled_jacobian(x);
+    const double sj = hex_scaled_jacobian(x);
     if (sj <= 0) fail("child " + std::to_string(c) + " is inverted or degenerate");
     min_sj = std::min(min_sj, sj);
-    volume += child_volume(x);
+    volume += hex_volume(x);
     for (int f = 0; f < 6; ++f) {
       std::array<int16_t, 4> q;
       for (int i = 0; i < 4; ++i) q[i] = tmpl.children[c][hex_faces[f][i]];

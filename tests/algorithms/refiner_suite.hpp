@@ -20,6 +20,7 @@
 #include "mesh/conformity.hpp"
 #include "mesh/generators.hpp"
 #include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
 #include "mesh/topology.hpp"
 
 namespace hexrefine {
@@ -33,23 +34,6 @@ struct RefinerSuiteVerdict {
   bool conformal() const { return nonmanifold_faces == 0 && interior_boundary_faces == 0; }
 };
 
-/// Scaled Jacobian of one hex (minimum over the 8 corners of the determinant of unit edges).
-inline double refiner_suite_scaled_jacobian(const std::array<Eigen::Vector3d, 8>& x) {
-  double out = 2.0;
-  for (int v = 0; v < 8; ++v) {
-    std::array<Eigen::Vector3d, 3> e;
-    for (int k = 0; k < 3; ++k) {
-      const int edge = hex_vertex_edges[v][k];
-      const int w = hex_edges[edge][0] == v ? hex_edges[edge][1] : hex_edges[edge][0];
-      e[k] = hex_corner[v][k] ? (x[v] - x[w]) : (x[w] - x[v]);
-      if (e[k].norm() == 0) return -1;
-      e[k].normalize();
-    }
-    out = std::min(out, e[0].dot(e[1].cross(e[2])));
-  }
-  return out;
-}
-
 /// `on_input_boundary(p)` says whether a point lies on the input's boundary surface.
 inline RefinerSuiteVerdict refiner_suite_check(
     const HexMesh& out, const std::function<bool(const Eigen::Vector3d&)>& on_input_boundary) {
@@ -62,7 +46,7 @@ inline RefinerSuiteVerdict refiner_suite_check(
     if (!ok) ++v.interior_boundary_faces;
   }
   for (int32_t h = 0; h < out.hex_count(); ++h) {
-    const double sj = refiner_suite_scaled_jacobian(hex_points(out, h));
+    const double sj = hex_scaled_jacobian(hex_points(out, h));
     if (!(sj > 0)) ++v.inverted_hexes;
     v.min_scaled_jacobian = std::min(v.min_scaled_jacobian, sj);
     // Doublets: a neighbour met through two faces.

@@ -21,6 +21,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "algorithms/selective.hpp"
 #include "algorithms/sheet.hpp"
@@ -146,6 +147,7 @@ bool mesh_same_exactly(const HexMesh& a, const HexMesh& b) {
 struct PropertyTally {
   int64_t cases = 0, refined = 0, refused = 0, all_hexes = 0;
   int64_t refused_per_refiner[2] = {0, 0};
+  std::vector<std::string> refused_examples;  ///< the first few refused cases
 };
 
 /// Runs cases [first, first + count); every violated property is a test failure naming the case.
@@ -164,6 +166,8 @@ PropertyTally property_run(int64_t first, int64_t count) {
       EXPECT_NE(msg.find("hex"), std::string::npos) << "refusal must name the hexes: " << msg;
       EXPECT_TRUE(mesh_same_exactly(before, c.mesh)) << "input modified by a refusal";
       ++t.refused, ++t.refused_per_refiner[c.sheet];
+      if (t.refused_examples.size() < 5)
+        t.refused_examples.push_back(c.description + ": " + msg.substr(0, 120));
       continue;
     } catch (const std::exception& e) {
       ADD_FAILURE() << "not an OperationError: " << e.what();
@@ -202,6 +206,7 @@ TEST(RefinerProperties, RandomMeshesAndTargetsGiveValidOutputOrANamedRefusal) {
       static_cast<long long>(t.refined), static_cast<long long>(t.refused),
       static_cast<long long>(t.refused_per_refiner[0]),
       static_cast<long long>(t.refused_per_refiner[1]), static_cast<long long>(t.all_hexes));
+  for (const std::string& e : t.refused_examples) std::printf("  refused: %s\n", e.c_str());
   EXPECT_EQ(t.cases, count);
   // Most cases must refine: a refiner that refused everything would pass the other checks.
   EXPECT_GE(t.refined, t.cases * 3 / 4);

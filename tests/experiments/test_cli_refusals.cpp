@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -158,6 +160,42 @@ TEST(CliRefusals, UnwritableOutputIsOperationErrorExit1) {
   int entries = 0;
   for (const auto& e : fs::directory_iterator(dir)) entries += e.path().filename() != "taken.mesh";
   EXPECT_EQ(entries, 0);
+}
+
+TEST(CliRefusals, RefinerRefusalIsExit1NamingTheHexesAndWritesNothing) {
+  // An O-grid cylinder (2x2 square, 2 radial, 1 layer) with targets 0 and 5: the selective
+  // refiner has no conformal answer (found by the property tests) and says so.
+  const auto dir = test_temp_dir("refusal_refiner");
+  const std::string in = (dir / "cyl.mesh").string(), out = (dir / "out.mesh").string();
+  ASSERT_EQ(cli_run("generate cylinder " + in + " --intervals 2,2 --layers 1").exit_code, 0);
+  std::ofstream(dir / "targets.txt") << "0 5\n";
+  const CliRun r = cli_run("refine " + in + " " + out +
+                           " --method selective --select hexes:" + (dir / "targets.txt").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(output_has(r,
+                         "cannot refine this configuration conformally; 1 input hexes "
+                         "affected: 11"))
+      << r.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// BUG (experiments/cli_refine.cpp:103, algorithms/selective.cpp:833, owned by the refiner
+// developers): a debugging switch left in the code, the environment variable SELDBG, turns off
+// the selective refiner's output check and the CLI's validity check, so `SELDBG=1 hexrefine
+// refine` writes the mesh below with 3 inverted hexes and exits 0 (and prints debugging output).
+// Skipped so CI stays green until the switch is removed; delete the GTEST_SKIP line then.
+TEST(CliRefusals, EnvironmentCannotTurnOffTheOutputCheck) {
+  GTEST_SKIP() << "known bug: SELDBG disables the output checks (see the comment above)";
+  const auto dir = test_temp_dir("refusal_seldbg");
+  const std::string in = (dir / "cyl.mesh").string(), out = (dir / "out.mesh").string();
+  ASSERT_EQ(cli_run("generate cylinder " + in + " --intervals 2,2 --layers 1").exit_code, 0);
+  std::ofstream(dir / "targets.txt") << "0 5\n";
+  ::setenv("SELDBG", "1", 1);  // inherited by the child that cli_run starts
+  const CliRun r = cli_run("refine " + in + " " + out +
+                           " --method selective --select hexes:" + (dir / "targets.txt").string());
+  ::unsetenv("SELDBG");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_FALSE(fs::exists(out)) << "a mesh with inverted hexes was written";
 }
 
 }  // namespace

@@ -18,11 +18,14 @@
 ///   is below 1 - threshold. Benchmarks with an error are listed as errors, not compared.
 /// - Exit codes: bench-compare returns 0 whatever the ratios (a comparison is information, not a
 ///   verdict) and 2 for unreadable or malformed input; bench returns 1 if an executable fails.
+/// - Google Benchmark prints NaN (not JSON) for undefined statistics such as the coefficient of
+///   variation of a counter that is always 0; both commands read such tokens as null.
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -104,6 +107,50 @@ struct BenchTimes {
   std::string error_message;
 };
 
+/// `text` with the non-JSON number tokens Google Benchmark prints for undefined statistics (NaN,
+/// e.g. the coefficient of variation of a counter that is always 0; inf, -inf; any case) replaced
+/// by null outside strings, so a strict JSON parser accepts it. Anything else is left as is.
+std::string json_without_nan(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      out += c;
+      if (c == '\\' && i + 1 < text.size()) {
+        out += text[++i];
+      } else if (c == '"') {
+        in_string = false;
+      }
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+      out += c;
+      continue;
+    }
+    bool replaced = false;
+    for (const char* token : {"-infinity", "infinity", "-inf", "inf", "-nan", "nan"}) {
+      const size_t n = std::char_traits<char>::length(token);
+      if (i + n > text.size()) continue;
+      bool match = true;
+      for (size_t k = 0; k < n && match; ++k)
+        match = std::tolower(static_cast<unsigned char>(text[i + k])) == token[k];
+      if (!match) continue;
+      const bool word_after =
+          i + n < text.size() && std::isalnum(static_cast<unsigned char>(text[i + n]));
+      if (word_after) continue;
+      out += "null";
+      i += n - 1;
+      replaced = true;
+      break;
+    }
+    if (!replaced) out += c;
+  }
+  return out;
+}
+
 double time_unit_seconds(const std::string& unit, const std::string& file,
                          const std::string& name) {
   if (unit == "ns") return 1e-9;
@@ -124,9 +171,11 @@ double median_of(std::vector<double> values) {
 std::map<std::string, BenchTimes> bench_read(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open");
+  std::stringstream content;
+  content << in.rdbuf();
   json doc;
   try {
-    doc = json::parse(in);
+    doc = json::parse(json_without_nan(content.str()));
   } catch (const json::exception& e) {
     throw InputError(path + ": not valid JSON: " + e.what());
   }
@@ -242,7 +291,7 @@ int cli_bench(const std::vector<std::string>& args) {
     if (output.find_first_not_of(" \t\r\n") == std::string::npos) continue;  // nothing matched
     json doc;
     try {
-      doc = json::parse(output);
+      doc = json::parse(json_without_nan(output));
     } catch (const json::exception& e) {
       throw OperationError("hexrefine bench: " + name + " printed invalid JSON: " + e.what());
     }

@@ -119,6 +119,23 @@ TEST(CliBenchCompare, UsesTheMedianAggregateWhenRepetitionsExist) {
   EXPECT_NE(r.output.find("summary: 1 compared"), std::string::npos) << r.output;
 }
 
+TEST(CliBenchCompare, AcceptsTheNaNGoogleBenchmarkPrints) {
+  // Google Benchmark prints NaN for the cv aggregate of a counter that is always 0.
+  const auto dir = test_temp_dir("cli_bench_compare_nan");
+  const std::string base = write_file(
+      dir, "base.json",
+      "{\"benchmarks\": [{\"name\": \"n/1_median\", \"run_name\": \"n/1\", \"run_type\": "
+      "\"aggregate\", \"aggregate_name\": \"median\", \"real_time\": 4, \"cpu_time\": 4, "
+      "\"time_unit\": \"ms\", \"zero\": 0}, {\"name\": \"n/1_cv\", \"run_name\": \"n/1\", "
+      "\"run_type\": \"aggregate\", \"aggregate_name\": \"cv\", \"real_time\": 0.1, "
+      "\"cpu_time\": 0.1, \"time_unit\": \"ms\", \"zero\": NaN, \"other\": -inf}]}");
+  const std::string now = write_file(dir, "new.json", document({entry("n/1", 2, 2, "ms")}));
+  const CliRun r = cli_run("bench-compare " + base + " " + now);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(line_of(r.output, "n/1").find("0.500"), std::string::npos) << r.output;
+  EXPECT_NE(line_of(r.output, "n/1").find("faster"), std::string::npos) << r.output;
+}
+
 TEST(CliBenchCompare, ErrorEntriesAreListedNotCompared) {
   const auto dir = test_temp_dir("cli_bench_compare_error");
   const std::string base = write_file(dir, "base.json", document({entry("e/1", 1, 1, "ms")}));

@@ -29,6 +29,8 @@ const char* usage_text =
     "  run CASES.json [--resume] [--quiet] [--shard K/N] [--output OUT.jsonl]\n"
     "  reproduce [--quick] [--resume] [--quiet] [--no-plots]\n"
     "  merge OUT.jsonl IN.jsonl [IN.jsonl ...]\n"
+    "  bench [--filter REGEX] [--out FILE.json] [--smoke] [--repetitions N]\n"
+    "  bench-compare BASE.json NEW.json [--threshold 0.05] [--by cpu|real]\n"
     "exit codes: 0 done, 1 the operation failed, 2 bad usage or bad input\n";
 
 }  // namespace
@@ -134,9 +136,17 @@ int cli_main(int argc, char** argv) {
   const std::string command = args[0];
   args.erase(args.begin());
   static const std::map<std::string, int (*)(const std::vector<std::string>&)> commands = {
-      {"generate", cli_generate}, {"check", cli_check},         {"convert", cli_convert},
-      {"sheets", cli_sheets},     {"refine", cli_refine},       {"smooth", cli_smooth},
-      {"run", cli_run},           {"reproduce", cli_reproduce}, {"merge", cli_merge},
+      {"generate", cli_generate},
+      {"check", cli_check},
+      {"convert", cli_convert},
+      {"sheets", cli_sheets},
+      {"refine", cli_refine},
+      {"smooth", cli_smooth},
+      {"run", cli_run},
+      {"reproduce", cli_reproduce},
+      {"merge", cli_merge},
+      {"bench", cli_bench},
+      {"bench-compare", cli_bench_compare},
   };
   const auto it = commands.find(command);
   if (it == commands.end()) {

@@ -44,5 +44,7 @@ int cli_smooth(const std::vector<std::string>& args);
 int cli_run(const std::vector<std::string>& args);
 int cli_reproduce(const std::vector<std::string>& args);
 int cli_merge(const std::vector<std::string>& args);
+int cli_bench(const std::vector<std::string>& args);
+int cli_bench_compare(const std::vector<std::string>& args);
 
 }  // namespace hexrefine

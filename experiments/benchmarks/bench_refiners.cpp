@@ -6,7 +6,11 @@
 /// (one sheet per pass) on the smaller bricks. Wall-clock times
 /// (UseRealTime). Counters: final hexes, hexes created and deleted, sheet passes, added targets,
 /// per-phase seconds (of the last iteration), and `s/initial_hex` (seconds per input hex; flat
-/// when the time grows linearly). A refiner that throws (e.g. not implemented yet) is reported
+/// when the time grows linearly), `hexes_in/s` and `hexes_out/s` (initial and final hexes per
+/// second) and `peak_rss_MB` (the benchmark's peak resident memory, VmHWM, reset at its start).
+/// Sizes: 10, 25, 50; 10 only under HEXREFINE_BENCH_SMOKE=1 (`hexrefine bench --smoke`); 75 (the
+/// thesis' largest brick: about 6 GB, tens of seconds) only under HEXREFINE_BENCH_LARGE=1.
+/// A refiner that throws (e.g. not implemented yet) is reported
 /// as a skipped benchmark with its message.
 ///
 /// Run (Release): bench_refiners --benchmark_repetitions=3
@@ -19,6 +23,7 @@
 
 #include "algorithms/selective.hpp"
 #include "algorithms/sheet.hpp"
+#include "experiments/benchmarks/bench_util.hpp"
 #include "mesh/generators.hpp"
 #include "mesh/hex_mesh.hpp"
 
@@ -73,6 +78,7 @@ Targets targets_block(const HexMesh& m, int32_t block) {
 void run(benchmark::State& state, RefineFunction refine, const HexMesh& mesh,
          const Targets& targets, const RefineOptions& options = {}) {
   RefineStats last;
+  bench_reset_peak_memory();
   try {
     for (auto _ : state) {
       RefineResult r = refine(mesh, targets, options);
@@ -95,6 +101,9 @@ void run(benchmark::State& state, RefineFunction refine, const HexMesh& mesh,
   state.counters["s/initial_hex"] = benchmark::Counter(
       static_cast<double>(mesh.hex_count()),
       benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  bench_set_hex_rate(state, "hexes_in/s", static_cast<double>(mesh.hex_count()));
+  bench_set_hex_rate(state, "hexes_out/s", static_cast<double>(last.final_hexes));
+  bench_set_peak_memory(state);
 }
 
 void bench_full_brick(benchmark::State& state, RefineFunction refine) {
@@ -141,17 +150,19 @@ RefineResult sheet_one_per_pass(const HexMesh& mesh, const Targets& targets,
 }
 
 void sizes(benchmark::internal::Benchmark* b) {
-  b->Arg(10)->Arg(25)->Arg(50)->Unit(benchmark::kMillisecond)->UseRealTime();
+  bench_brick_sizes(b, 10, 10);
 }
 
 BENCHMARK_CAPTURE(bench_full_brick, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, selective, selective)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, sheet_one_per_pass, &sheet_one_per_pass)
-    ->Arg(10)
-    ->Arg(20)
-    ->Arg(25)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+    ->Apply([](benchmark::internal::Benchmark* b) {
+      if (bench_smoke())
+        b->Arg(10);
+      else
+        b->Arg(10)->Arg(20)->Arg(25);
+      b->Unit(benchmark::kMillisecond)->UseRealTime();
+    });
 BENCHMARK_CAPTURE(bench_radial, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_radial, selective, selective)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_l_shaped, sheet, sheet)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -12,6 +12,7 @@
 ///   i.e. beside the source tree when the build folder is <source>/build).
 
 #include <benchmark/benchmark.h>
+#include <malloc.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -51,8 +52,12 @@ inline void bench_brick_sizes(benchmark::internal::Benchmark* b, int smoke, int 
 
 /// Resets the process' peak resident set size (Linux >= 4.0: "5" to /proc/self/clear_refs), so
 /// that the peak read at the end of a benchmark is that benchmark's own, not an earlier one's.
-/// Silently does nothing where unsupported (the counter then is the process peak so far).
+/// The reset sets the peak to the current resident size, so free heap memory is first returned
+/// to the system (malloc_trim): without it, memory an earlier benchmark freed but glibc kept
+/// would count towards this one's peak. Silently does nothing where unsupported (the counter
+/// then is the process peak so far).
 inline void bench_reset_peak_memory() {
+  malloc_trim(0);
   std::ofstream clear("/proc/self/clear_refs");
   if (clear) clear << "5";
 }

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -60,17 +61,28 @@ TEST(IoFuzzRegressions, MemoryReaderMatchesFileReaderInEveryFormat) {
   }
   // The Exodus path goes through a temporary file; it must be gone afterwards (also when the
   // read fails) and the message must name the caller's source, not the temporary file.
-  auto memory_files = [] {
+  // A private temporary folder (TMPDIR) so that other processes (parallel tests, fuzzers) writing
+  // their own temporary files cannot disturb the count.
+  const auto private_tmp = std::filesystem::temp_directory_path() / "hexrefine_test_memory_tmp";
+  std::filesystem::remove_all(private_tmp);
+  std::filesystem::create_directories(private_tmp);
+  const char* old_tmpdir = std::getenv("TMPDIR");
+  const std::string saved = old_tmpdir ? old_tmpdir : "";
+  ::setenv("TMPDIR", private_tmp.c_str(), 1);
+  auto memory_files = [&] {
     int n = 0;
-    for (const auto& e :
-         std::filesystem::directory_iterator(std::filesystem::temp_directory_path()))
+    for (const auto& e : std::filesystem::directory_iterator(private_tmp))
       n += e.path().filename().string().rfind("hexrefine_memory_", 0) == 0;
     return n;
   };
-  const int before = memory_files();
   const std::string msg = refusal_of("given.e", "CDF\x02 truncated");
+  const int left = memory_files();
+  if (old_tmpdir)
+    ::setenv("TMPDIR", saved.c_str(), 1);
+  else
+    ::unsetenv("TMPDIR");
   EXPECT_EQ(msg.rfind("given.e: ", 0), 0u) << msg;
-  EXPECT_EQ(memory_files(), before);
+  EXPECT_EQ(left, 0);
   EXPECT_NE(refusal_of("given.stl", "solid").find("unknown mesh format"), std::string::npos);
 }
 

@@ -7,9 +7,10 @@
 /// with --smooth (algorithms/smoothing.hpp), checks the result against
 /// the input with the project's checker (mesh/conformity.hpp) and writes OUT and the report.
 /// Exit codes: 2 bad usage or input (inverted input hexes unless --allow-inverted: "N inverted
-/// hexes, first at id K"); 1 the refiner cannot handle the configuration (the message names the
-/// hexes; nothing is written), or, with the default switches, the checker finds the result
-/// non-conformal or inverted (nothing is written either). With an ablation switch (--no-ranking,
+/// hexes, first at id K"; an input the checker finds invalid, when the result is invalid too); 1
+/// the refiner cannot handle the configuration (the message names the hexes; nothing is written),
+/// or, with the default switches, the checker finds the result non-conformal or inverted (nothing
+/// is written either). With an ablation switch (--no-ranking,
 /// --no-propagation, --ebe-only) the result may be non-conformal by design: it is written and the
 /// checker's counts go to the report. A selection that matches nothing: a warning, the mesh is
 /// written unchanged, exit 0.
@@ -107,6 +108,14 @@ int cli_refine(const std::vector<std::string>& args) {
   // inversion) and both verdicts go to the report.
   const MeshCheckReport refined_check = mesh_check(result.mesh, &input);
   if (!ablation && !options.allow_inverted && !refined_check.valid()) {
+    // An input that already fails the checker (e.g. a voxel mesh whose cubes touch along
+    // edges) is bad input, not a refiner failure.
+    const MeshCheckReport input_check = mesh_check(input);
+    if (!input_check.valid()) {
+      std::string why;
+      for (const std::string& d : mesh_check_defects(input_check)) why += "\n  " + d;
+      throw InputError(in + ": the input mesh is not valid, so no refinement of it can be:" + why);
+    }
     std::string why;
     for (const std::string& d : mesh_check_defects(refined_check)) why += "\n  " + d;
     throw OperationError("hexrefine refine: the " + method +

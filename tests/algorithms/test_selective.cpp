@@ -519,7 +519,10 @@ TEST(SelectiveResults, DISABLED_WriteResults) {
             std::tuple{"ellipsoid.mesh", Eigen::Vector3d(0, 0, 0), 0.25},
             std::tuple{"ellipsoid.mesh", Eigen::Vector3d(0.1, 0.1, 0.3), 0.12},
             std::tuple{"rockerarm.mesh", Eigen::Vector3d(0, 0, 0), 8.0},
-            std::tuple{"rockerarm.mesh", Eigen::Vector3d(0, 0, 20), 10.0}}) {
+            std::tuple{"rockerarm.mesh", Eigen::Vector3d(0, 0, 20), 10.0},
+            std::tuple{"cube_minus_sphere_conforming.mesh", Eigen::Vector3d(0, 0, 0), 0.2857},
+            std::tuple{"sphere_conforming.mesh", Eigen::Vector3d(0, 0, 0), 0.5},
+            std::tuple{"bunny_conforming.mesh", Eigen::Vector3d(0, 0, 0), 0.5}}) {
         const HexMesh m = mesh_read(shared_mesh(file));
         std::ostringstream name;
         name << file << ", sphere r=" << r << " at (" << c.transpose() << ")";

@@ -117,6 +117,17 @@ TEST(CliRefine, BadUsageAndInvertedInputExitTwo) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+TEST(CliRefine, InvalidInputIsReportedAsBadInput) {
+  // bunny_voxel.mesh: cubes touching along edges (122 non-manifold boundary edges).
+  const auto dir = test_temp_dir("cli_refine_invalid_input");
+  const std::string out = (dir / "o.vtk").string();
+  const CliRun r = cli_run(join({"refine", shared_mesh("bunny_voxel.mesh"), out,
+                                 "--method selective --select sphere:0,0,0,1"}));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("input mesh is not valid"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST(CliRefine, UnhandledConfigurationExitsOneNamingHexesAndWritesNothing) {
   // One of the random configurations (results/selective_random.md) the refiner refuses.
   const auto dir = test_temp_dir("cli_refine_refused");

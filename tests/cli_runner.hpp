@@ -16,12 +16,10 @@ struct CliRun {
   std::string output;  ///< stdout and stderr together
 };
 
-/// Runs `hexrefine ARGS` (ARGS is passed to the shell as written) and returns its exit code and
-/// combined output.
-inline CliRun cli_run(const std::string& args) {
-  const std::string cmd = std::string(HEXREFINE_EXE) + " " + args + " 2>&1";
+/// Runs a shell command line (stderr joined to stdout) and returns its exit code and output.
+inline CliRun shell_run(const std::string& command) {
   CliRun r;
-  FILE* pipe = popen(cmd.c_str(), "r");
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
   if (!pipe) return r;
   std::array<char, 4096> buf{};
   size_t n;
@@ -29,6 +27,12 @@ inline CliRun cli_run(const std::string& args) {
   const int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return r;
+}
+
+/// Runs `hexrefine ARGS` (ARGS is passed to the shell as written) and returns its exit code and
+/// combined output.
+inline CliRun cli_run(const std::string& args) {
+  return shell_run(std::string(HEXREFINE_EXE) + " " + args);
 }
 
 /// A fresh empty folder under the system temp dir, unique per test name.

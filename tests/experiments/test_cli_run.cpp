@@ -165,17 +165,8 @@ namespace {
 
 /// Runs experiments/plots.py (matplotlib is a CI dependency, .ci/setup.sh).
 CliRun plots_py(const std::string& args) {
-  const std::string cmd = std::string("/usr/bin/python3 ") + HEXREFINE_SOURCE_DIR +
-                          "/experiments/plots.py " + args + " 2>&1";
-  CliRun r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return r;
+  return shell_run(std::string("/usr/bin/python3 ") + HEXREFINE_SOURCE_DIR +
+                   "/experiments/plots.py " + args);
 }
 
 TEST(PlotsPy, PutsOursBesideTheThesisWithRatios) {

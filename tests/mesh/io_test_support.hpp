@@ -8,10 +8,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <string>
 
 #include "fixtures.hpp"
+#include "mesh/error.hpp"
 #include "mesh/hex_mesh.hpp"
+#include "mesh/io.hpp"
 
 namespace hexrefine {
 
@@ -68,6 +71,24 @@ inline void io_expect_same_attribute(const HexMesh& a, const HexMesh& b, std::st
 
 inline void io_write_text(const std::filesystem::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
+}
+
+/// Writes each (text, expected) case to `dir`/badN`extension` and checks that mesh_read refuses it
+/// with an InputError whose message names the file and contains `expected`.
+inline void io_expect_refusals(const std::filesystem::path& dir, const std::string& extension,
+                               std::span<const std::pair<std::string, std::string>> cases) {
+  int i = 0;
+  for (const auto& [text, expected] : cases) {
+    const auto p = dir / ("bad" + std::to_string(i++) + extension);
+    io_write_text(p, text);
+    try {
+      mesh_read(p.string());
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace hexrefine

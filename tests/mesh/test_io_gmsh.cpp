@@ -59,18 +59,7 @@ TEST(IoGmsh, RefusesTetsBinaryAndUndefinedNodes) {
       {"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 100000000000 1 4\n",
        "node count 100000000000"},
   };
-  int i = 0;
-  for (const auto& [text, expected] : cases) {
-    const auto p = dir / ("bad" + std::to_string(i++) + ".msh");
-    io_write_text(p, text);
-    try {
-      mesh_read(p.string());
-      ADD_FAILURE() << "accepted: " << expected;
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
-    }
-  }
+  io_expect_refusals(dir, ".msh", cases);
 }
 
 }  // namespace

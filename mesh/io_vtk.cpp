@@ -190,6 +190,28 @@ void vtk_read_array(TextCursor& in, bool binary, VtkReadState& st, bool cell_dat
 }
 
 /// Reads the arrays after "CELL_DATA n" / "POINT_DATA n" until the next block keyword.
+/// A FIELD block (after its keyword): arrays whose tuple count equals `cell_count` are kept as cell
+/// data; the others, and all of them when cell_count < 0 (dataset-level data such as TIME), are
+/// read and skipped. An array may be followed by its METADATA lines.
+void vtk_read_field(TextCursor& in, bool binary, VtkReadState& st, int64_t cell_count) {
+  in.token("field name");
+  const int64_t arrays = in.integer_in("field array count", 0, 1 << 20);
+  for (int64_t a = 0; a < arrays; ++a) {
+    const std::string name(in.token("array name"));
+    const int64_t components = in.integer("component count");
+    const int64_t tuples = in.integer("tuple count");
+    if (tuples < 0 || tuples > INT32_MAX) in.fail("array '" + name + "': bad tuple count");
+    const std::string_view type = in.token("data type");
+    vtk_read_array(in, binary, st, cell_count >= 0 && tuples == cell_count, name, type, components,
+                   tuples);
+    if (in.peek() == "METADATA") {
+      in.token("METADATA");
+      while (!in.at_end() && !in.rest_of_line().empty()) {
+      }
+    }
+  }
+}
+
 void vtk_read_data_block(TextCursor& in, bool binary, VtkReadState& st, bool cell_data, int64_t n) {
   while (!in.at_end()) {
     const std::string_view key = in.peek();
@@ -204,21 +226,7 @@ void vtk_read_data_block(TextCursor& in, bool binary, VtkReadState& st, bool cel
       if (in.peek() == "LOOKUP_TABLE") in.token("LOOKUP_TABLE"), in.token("lookup table name");
       vtk_read_array(in, binary, st, cell_data, name, type, components, n);
     } else if (key == "FIELD") {
-      in.token("field name");
-      const int64_t arrays = in.integer_in("field array count", 0, 1 << 20);
-      for (int64_t a = 0; a < arrays; ++a) {
-        const std::string name(in.token("array name"));
-        const int64_t components = in.integer("component count");
-        const int64_t tuples = in.integer("tuple count");
-        if (tuples < 0 || tuples > INT32_MAX) in.fail("array '" + name + "': bad tuple count");
-        const std::string_view type = in.token("data type");
-        vtk_read_array(in, binary, st, cell_data && tuples == n, name, type, components, tuples);
-        if (in.peek() == "METADATA") {
-          in.token("METADATA");
-          while (!in.at_end() && !in.rest_of_line().empty()) {
-          }
-        }
-      }
+      vtk_read_field(in, binary, st, cell_data ? n : -1);
     } else if (key == "VECTORS" || key == "NORMALS" || key == "TENSORS" || key == "TENSORS6") {
       const std::string name(in.token("array name"));
       const std::string_view type = in.token("data type");
@@ -380,15 +388,7 @@ HexMesh vtk_read(const std::string& path, const std::string& text) {
         in.fail("POINT_DATA count " + std::to_string(n) + " does not match the point count");
       vtk_read_data_block(in, binary, st, key == "CELL_DATA", n);
     } else if (key == "FIELD") {  // dataset-level field data (e.g. TIME): skipped
-      in.token("field name");
-      const int64_t arrays = in.integer_in("field array count", 0, 1 << 20);
-      for (int64_t a = 0; a < arrays; ++a) {
-        const std::string name(in.token("array name"));
-        const int64_t components = in.integer("component count");
-        const int64_t tuples = in.integer("tuple count");
-        const std::string_view type = in.token("data type");
-        vtk_read_array(in, binary, st, false, name, type, components, tuples);
-      }
+      vtk_read_field(in, binary, st, -1);
     } else if (key == "METADATA") {
       while (!in.at_end() && !in.rest_of_line().empty()) {
       }

@@ -10,10 +10,13 @@
 /// of 1..n, so a written mesh reads back in its own order.
 
 #include <exodusII.h>
+#include <netcdf.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "mesh/atomic_file.hpp"
 #include "mesh/io.hpp"
@@ -160,6 +163,109 @@ bool netcdf_classic_header_check(const std::string& path, std::string_view bytes
   return !truncated;
 }
 
+/// Closes a netCDF id on every path out.
+struct NetcdfFile {
+  int id = -1;
+  ~NetcdfFile() {
+    if (id >= 0) nc_close(id);
+  }
+};
+
+bool netcdf_type_is_number(nc_type type) {
+  return type != NC_CHAR && type >= NC_BYTE && type <= NC_UINT64 && type != NC_STRING;
+}
+
+/// Checks, through the netCDF API (classic and HDF5 files alike), what libexodusii 6.02 takes on
+/// trust, so that ex_open and the ex_get_* calls of exodus_read only see files they handle:
+/// - ex_open fails after its nc_open succeeded when the global attribute `version` is missing,
+///   not a number or below 2.0, or when no float word size attribute is found, and then never
+///   closes the netCDF file: one file descriptor and the netCDF file's memory leak per refused
+///   file (this is what made the Exodus fuzz target die after ~300,000 inputs).
+/// - ex_open reads `version`, the float word size and `int64_status` with nc_get_att_*, which
+///   writes every value of the attribute into a single float or int: an attribute with several
+///   values overwrites the stack (ours for `version`, libexodusii's for the others).
+/// - ex_get_block copies the `elem_type` attribute whole into a MAX_STR_LENGTH + 1 buffer.
+/// - ex_get_coord, ex_get_ids, ex_get_id_map and ex_get_conn read a whole variable into a buffer
+///   sized from the dimensions with the expected names (num_nodes, num_el_blk, num_elem,
+///   num_el_in_blkK x num_nod_per_elK), so each variable must be defined over exactly those.
+/// Throws InputError naming `path` and the attribute or variable.
+void exodus_netcdf_check(const std::string& path) {
+  NetcdfFile file;
+  if (nc_open(path.c_str(), NC_NOWRITE, &file.id) != NC_NOERR) {
+    file.id = -1;
+    throw InputError(path + ": cannot open as netCDF (corrupt or truncated file)");
+  }
+  auto attribute_number = [&](const char* name, double& value) {
+    nc_type type = NC_NAT;
+    size_t length = 0;
+    if (nc_inq_att(file.id, NC_GLOBAL, name, &type, &length) != NC_NOERR) return false;
+    if (!netcdf_type_is_number(type) || length != 1)
+      throw InputError(path + ": global attribute '" + name + "' must be a single number (has " +
+                       std::to_string(length) + " values of netCDF type " + std::to_string(type) +
+                       ")");
+    if (nc_get_att_double(file.id, NC_GLOBAL, name, &value) != NC_NOERR)
+      throw InputError(path + ": cannot read global attribute '" + name + "'");
+    return true;
+  };
+  double value = 0;
+  for (const char* name :
+       {"api_version", "api version", "file_size", "maximum_name_length", "int64_status"})
+    attribute_number(name, value);
+  if (!attribute_number("version", value) || !(value >= 2.0 && value < 1e6))
+    throw InputError(path + ": not an Exodus II file (global attribute 'version' missing or " +
+                     "below 2.0)");
+  if (!attribute_number("floating_point_word_size", value) &&
+      !attribute_number("floating point word size", value))
+    throw InputError(path + ": not an Exodus II file (no 'floating_point_word_size' attribute)");
+  if (value != 4 && value != 8)
+    throw InputError(path + ": floating point word size " + std::to_string(value) +
+                     ", expected 4 or 8");
+  int variables = 0;
+  if (nc_inq_nvars(file.id, &variables) != NC_NOERR)
+    throw InputError(path + ": cannot list the netCDF variables");
+  char name[NC_MAX_NAME + 1] = {0};
+  char dimension[NC_MAX_NAME + 1] = {0};
+  for (int v = 0; v < variables; ++v) {
+    int rank = 0;
+    int dims[NC_MAX_VAR_DIMS] = {0};
+    if (nc_inq_varname(file.id, v, name) != NC_NOERR ||
+        nc_inq_varndims(file.id, v, &rank) != NC_NOERR || rank < 0 || rank > NC_MAX_VAR_DIMS ||
+        nc_inq_vardimid(file.id, v, dims) != NC_NOERR)
+      throw InputError(path + ": cannot read netCDF variable " + std::to_string(v));
+    nc_type type = NC_NAT;
+    size_t length = 0;
+    if (nc_inq_att(file.id, v, "elem_type", &type, &length) == NC_NOERR &&
+        (type != NC_CHAR || length > MAX_STR_LENGTH))
+      throw InputError(path + ": variable '" + name + "': attribute 'elem_type' of " +
+                       std::to_string(length) + " values, expected at most " +
+                       std::to_string(MAX_STR_LENGTH) + " characters");
+    const std::string_view n(name);
+    std::vector<std::string> expected;
+    if (n == "coordx" || n == "coordy" || n == "coordz")
+      expected = {"num_nodes"};
+    else if (n == "coord")
+      expected = {"num_dim", "num_nodes"};
+    else if (n == "eb_prop1")
+      expected = {"num_el_blk"};
+    else if (n == "elem_num_map")
+      expected = {"num_elem"};
+    else if (n.substr(0, 7) == "connect") {
+      const std::string k(n.substr(7));
+      expected = {"num_el_in_blk" + k, "num_nod_per_el" + k};
+    } else
+      continue;
+    bool match = rank == static_cast<int>(expected.size());
+    for (int d = 0; match && d < rank; ++d)
+      match = nc_inq_dimname(file.id, dims[d], dimension) == NC_NOERR && expected[d] == dimension;
+    if (!match) {
+      std::string shape;
+      for (const std::string& e : expected) shape += (shape.empty() ? "" : ", ") + e;
+      throw InputError(path + ": variable '" + name + "' is not defined over (" + shape +
+                       "): corrupt Exodus II file");
+    }
+  }
+}
+
 }  // namespace
 
 HexMesh exodus_read(const std::string& path) {
@@ -192,6 +298,7 @@ HexMesh exodus_read(const std::string& path) {
       }
     }
   }
+  exodus_netcdf_check(path);
   ex_opts(EX_DEFAULT);  // report errors through return codes only; never abort
   int comp_ws = 8, io_ws = 0;
   float version = 0;

@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "experiments/cli.hpp"
+#include "experiments/cli_output.hpp"
 #include "mesh/error.hpp"
 #include "mesh/io.hpp"
 #include "mesh/quality.hpp"
@@ -23,6 +24,7 @@ int cli_convert(const std::vector<std::string>& args) {
   const std::string& out = a.positional[1];
   const MeshFormat out_format = mesh_format_of(out);
   mesh_format_of(in);
+  cli_output_check("hexrefine convert", out, CliOutputKind::mesh);
   MeshWriteOptions options;
   options.binary = a.flag("--binary");
   if (options.binary && out_format != MeshFormat::vtk_legacy)

@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "experiments/cli.hpp"
+#include "experiments/cli_output.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"
 #include "mesh/io.hpp"
@@ -66,6 +67,7 @@ int cli_generate(const std::vector<std::string>& args) {
       throw InputError("hexrefine generate " + kind + ": expected one output path, got " +
                        std::to_string(a.positional.size()) + " positional arguments\n" +
                        generate_usage);
+    cli_output_check("hexrefine generate " + kind, a.positional[0], CliOutputKind::mesh);
     return a.positional[0];
   };
 

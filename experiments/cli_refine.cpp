@@ -1,8 +1,14 @@
 /// \file
 /// `hexrefine refine IN OUT --method selective|sheet --select SPEC [--select SPEC ...]
 /// [--passes N] [--buffer] [--smooth] [--no-ranking] [--no-propagation] [--ebe-only]
-/// [--allow-inverted] [--report R.json]`
+/// [--allow-inverted] [--max-hexes N] [--report R.json]`
 ///
+/// OUT (its format and folder) and R are checked before IN is read (cli_output.hpp). The refined
+/// mesh's size is bounded before refining: each pass splits a hex into at most 27, so IN's n hexes
+/// give at most n * 27^passes; above --max-hexes N (default and maximum 2^31 - 1, the int32 hex
+/// ids) the command refuses with exit 1 before any work. The bound is reached by
+/// `--select all` and is pessimistic for a small selection (a sheet or a propagation may cross
+/// the whole mesh, so no smaller bound holds for every input).
 /// Reads IN, selects the targets (mesh/selection.hpp), refines them, smooths the refined region
 /// with --smooth (algorithms/smoothing.hpp), checks the result against
 /// the input with the project's checker (mesh/conformity.hpp) and writes OUT and the report.
@@ -16,12 +22,18 @@
 /// written unchanged, exit 0.
 
 #include <chrono>
+#include <cmath>
+#include <iomanip>
 #include <iostream>
+#include <limits>
+#include <optional>
+#include <sstream>
 
 #include "algorithms/selective.hpp"
 #include "algorithms/sheet.hpp"
 #include "algorithms/smoothing.hpp"
 #include "experiments/cli.hpp"
+#include "experiments/cli_output.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/conformity.hpp"
 #include "mesh/error.hpp"
@@ -37,14 +49,24 @@ namespace {
 const char* refine_usage =
     "usage: hexrefine refine IN OUT --method selective|sheet --select SPEC [--select SPEC ...]\n"
     "       [--passes N] [--buffer] [--smooth] [--no-ranking] [--no-propagation] [--ebe-only]\n"
-    "       [--allow-inverted] [--report R.json]\n";
+    "       [--allow-inverted] [--max-hexes N] [--report R.json]\n";
+
+/// n * 27^passes, saturated at INT64_MAX.
+int64_t refine_hex_bound(int64_t hexes, int passes) {
+  int64_t bound = hexes;
+  for (int p = 0; p < passes; ++p)
+    bound = bound > std::numeric_limits<int64_t>::max() / 27 ? std::numeric_limits<int64_t>::max()
+                                                             : bound * 27;
+  return bound;
+}
 
 }  // namespace
 
 int cli_refine(const std::vector<std::string>& args) {
-  const CliArgs a = cli_parse("refine", args, {"--method", "--select", "--passes", "--report"},
-                              {"--buffer", "--smooth", "--no-ranking", "--no-propagation",
-                               "--ebe-only", "--allow-inverted"});
+  const CliArgs a =
+      cli_parse("refine", args, {"--method", "--select", "--passes", "--report", "--max-hexes"},
+                {"--buffer", "--smooth", "--no-ranking", "--no-propagation", "--ebe-only",
+                 "--allow-inverted"});
   if (a.positional.size() != 2)
     throw InputError(std::string("hexrefine refine: expected IN and OUT\n") + refine_usage);
   const std::string in = a.positional[0], out = a.positional[1];
@@ -67,8 +89,35 @@ int cli_refine(const std::vector<std::string>& args) {
   options.ebe_only = a.flag("--ebe-only");
   options.allow_inverted = a.flag("--allow-inverted");
   const bool ablation = !options.ranking || !options.propagation || options.ebe_only;
+  int64_t max_hexes = std::numeric_limits<int32_t>::max();
+  if (const auto m = a.value("--max-hexes")) {
+    const long long n = cli_parse_int(*m, "--max-hexes");
+    if (n < 1 || n > max_hexes)
+      throw InputError("hexrefine refine: --max-hexes must be in 1.." + std::to_string(max_hexes) +
+                       " (int32 hex ids), got " + *m);
+    max_hexes = n;
+  }
+  cli_output_check("hexrefine refine", out, CliOutputKind::mesh);
+  const std::optional<std::string> report_path = a.value("--report");
+  if (report_path) cli_output_check("hexrefine refine", *report_path, CliOutputKind::report);
 
   const HexMesh input = mesh_read(in);
+  const int64_t bound = refine_hex_bound(input.hex_count(), options.passes);
+  if (bound > max_hexes) {
+    const double exact = static_cast<double>(input.hex_count()) * std::pow(27.0, options.passes);
+    std::ostringstream estimate;
+    if (bound < std::numeric_limits<int64_t>::max())
+      estimate << bound;
+    else
+      estimate << std::setprecision(3) << exact;
+    throw OperationError("hexrefine refine: " + in + " has " + std::to_string(input.hex_count()) +
+                         " hexes; " + std::to_string(options.passes) + " passes can give up to " +
+                         std::to_string(input.hex_count()) + " x 27^" +
+                         std::to_string(options.passes) + " = " + estimate.str() +
+                         " hexes, above the limit of " + std::to_string(max_hexes) +
+                         " hexes (--max-hexes; at most 2^31 - 1, the int32 hex ids); nothing "
+                         "refined or written: use fewer passes");
+  }
   if (!options.allow_inverted) {
     int64_t inverted = 0;
     int32_t first = -1;
@@ -155,8 +204,8 @@ int cli_refine(const std::vector<std::string>& args) {
     report["smooth"] = smooth_report;
     report["check_before_smoothing"] = mesh_check_to_json(refined_check);
   }
-  if (const auto r = a.value("--report"))
-    file_write_atomically(*r, [&](std::ostream& os) { os << report.dump(2) << "\n"; });
+  if (report_path)
+    file_write_atomically(*report_path, [&](std::ostream& os) { os << report.dump(2) << "\n"; });
 
   std::cout << method << ": " << result.stats.initial_hexes << " -> " << result.stats.final_hexes
             << " hexes, " << (check.conformal ? "conformal" : "NOT conformal") << ", "

@@ -14,6 +14,7 @@
 
 #include "algorithms/smoothing.hpp"
 #include "experiments/cli.hpp"
+#include "experiments/cli_output.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
 #include "mesh/io.hpp"
@@ -30,7 +31,7 @@ int cli_smooth(const std::vector<std::string>& args) {
   const std::string& in = a.positional[0];
   const std::string& out = a.positional[1];
   mesh_format_of(in);
-  mesh_format_of(out);
+  cli_output_check("hexrefine smooth", out, CliOutputKind::mesh);
 
   SmoothOptions options;
   if (const auto method = a.value("--method")) {
@@ -50,6 +51,7 @@ int cli_smooth(const std::vector<std::string>& args) {
   }
   const std::vector<std::string> region_specs = a.all("--region");
   const std::optional<std::string> report_path = a.value("--report");
+  if (report_path) cli_output_check("hexrefine smooth", *report_path, CliOutputKind::report);
 
   HexMesh mesh = mesh_read(in);
   std::string warning;

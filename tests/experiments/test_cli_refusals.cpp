@@ -142,21 +142,22 @@ TEST(CliRefusals, UnknownMethodFormatOrCommandIsUsageErrorExit2) {
   EXPECT_FALSE(fs::exists(dir / "o.stl"));
 }
 
-TEST(CliRefusals, UnwritableOutputIsOperationErrorExit1) {
-  // mesh/atomic_file.hpp documents OperationError (exit 1) when the file cannot be created.
+TEST(CliRefusals, UnwritableOutputIsInputErrorExit2BeforeAnyWork) {
+  // experiments/cli_output.hpp: the output path is checked before the input is read.
   const auto dir = test_temp_dir("refusal_unwritable");
   const std::string in = shared_mesh("sphere_conforming.mesh");
   const std::string missing = (dir / "no_such_folder" / "o.mesh").string();
   const CliRun r = cli_run("refine " + in + " " + missing + " --method sheet --select all");
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_TRUE(output_has(r, "no_such_folder/o.mesh: cannot open for writing")) << r.output;
-  // An output path that is an existing folder: the rename over it fails.
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(output_has(r, "cannot write " + missing + ": folder ")) << r.output;
+  EXPECT_TRUE(output_has(r, "no_such_folder does not exist")) << r.output;
+  // An output path that is an existing folder.
   fs::create_directories(dir / "taken.mesh");
   const CliRun folder = cli_run("convert " + in + " " + (dir / "taken.mesh").string());
-  EXPECT_EQ(folder.exit_code, 1) << folder.output;
-  EXPECT_TRUE(output_has(folder, "taken.mesh: cannot write")) << folder.output;
+  EXPECT_EQ(folder.exit_code, 2) << folder.output;
+  EXPECT_TRUE(output_has(folder, "taken.mesh: it is a folder")) << folder.output;
   EXPECT_TRUE(fs::is_directory(dir / "taken.mesh"));
-  // Neither failure leaves a temporary file behind.
+  // Neither failure leaves a temporary or probe file behind.
   int entries = 0;
   for (const auto& e : fs::directory_iterator(dir)) entries += e.path().filename() != "taken.mesh";
   EXPECT_EQ(entries, 0);

@@ -11,7 +11,9 @@
 # $FUZZ_BUILD_DIR/fuzz-corpus/<format>/ and crash/timeout/oom inputs to
 # $FUZZ_BUILD_DIR/fuzz-artifacts/<format>/; a crash file belongs in tests/fuzz/crashes/ once fixed
 # (test_io_fuzz_regressions.cpp reads every file there). Exit status 1 if any target found
-# something.
+# something in this run (a non-zero libFuzzer exit or a new file in its artifact folder): the
+# path of each such input and the end of the target's log are printed, so a CI log shows what
+# to reproduce with `$FUZZ_BUILD_DIR/tests/fuzz/fuzz_<format> <input>`; 2 if the build failed.
 set -u
 if [ $# -lt 1 ] || ! [[ "$1" =~ ^[0-9]+$ ]]; then
   echo "usage: $0 SECONDS [TARGET ...]  (targets: medit vtk_ascii vtk_binary vtu gmsh22 gmsh41 abaqus exodus)" >&2
@@ -56,6 +58,8 @@ run_one() {
   local t=$1
   local work="$build/fuzz-corpus/$t" art="$build/fuzz-artifacts/$t/"
   mkdir -p "$work" "$art"
+  # Inputs kept from earlier runs are not this run's findings: only files newer than this mark.
+  touch "$build/fuzz-$t.start"
   # UBSan: stop at the first report so it counts as a crash.
   UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
     "$build/tests/fuzz/fuzz_$t" "$work" "$here/corpus/$t" \
@@ -87,7 +91,7 @@ for t in "${targets[@]}"; do
   ft=$(echo "$last" | sed -n 's/.*ft: \([0-9]*\).*/\1/p')
   corp=$(echo "$last" | sed -n 's/.*corp: \([0-9]*\).*/\1/p')
   rc=$(cat "$build/fuzz-$t.rc" 2>/dev/null || echo "?")
-  found=$(ls "$build/fuzz-artifacts/$t/" 2>/dev/null | wc -l)
+  found=$(find "$build/fuzz-artifacts/$t/" -type f -newer "$build/fuzz-$t.start" 2>/dev/null | wc -l)
   result=ok
   if [ "$rc" != 0 ] || [ "$found" -gt 0 ]; then
     result="FOUND $found input(s) in $build/fuzz-artifacts/$t/ (rc $rc, see $log)"
@@ -95,5 +99,16 @@ for t in "${targets[@]}"; do
   fi
   printf '%-11s %8s %12s %9s %7s %7s %8s  %s\n' "$t" "$seconds" "${execs:-?}" "${rate:-?}" \
     "${cov:-?}" "${ft:-?}" "${corp:-?}" "$result"
+done
+for t in "${targets[@]}"; do
+  rc=$(cat "$build/fuzz-$t.rc" 2>/dev/null || echo "?")
+  inputs=$(find "$build/fuzz-artifacts/$t/" -type f -newer "$build/fuzz-$t.start" 2>/dev/null)
+  if [ "$rc" != 0 ] || [ -n "$inputs" ]; then
+    echo
+    echo "=== fuzz_$t found something (libFuzzer exit $rc); input(s):"
+    for f in $inputs; do echo "  $f"; done
+    echo "--- end of $build/fuzz-$t.log:"
+    tail -40 "$build/fuzz-$t.log"
+  fi
 done
 exit $status

@@ -102,6 +102,15 @@ TEST(CliRefineSizeGuard, TenFullPassesOfOneCubeAreRefusedBeforeRefining) {
   EXPECT_EQ(sheet.exit_code, 1) << sheet.output;
   EXPECT_TRUE(output_has(sheet, "8 x 27^10 = 1647129056757192 hexes")) << sheet.output;
   EXPECT_FALSE(fs::exists(out));
+  // 36^3 = 46,656 hexes x 27^10 = 9.61e18 is beyond int64: the bound saturates and the message
+  // gives it in floating point.
+  const std::string big = (dir / "big.mesh").string();
+  ASSERT_EQ(cli_run("generate brick " + big + " --dims 36,36,36").exit_code, 0);
+  const CliRun saturated =
+      cli_run("refine " + big + " " + out + " --method selective --select all --passes 10");
+  EXPECT_EQ(saturated.exit_code, 1) << saturated.output;
+  EXPECT_TRUE(output_has(saturated, "46656 x 27^10 = 9.61e+18 hexes")) << saturated.output;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(CliRefineSizeGuard, MaxHexesSetsTheLimitAndNormalRefinementPasses) {

@@ -149,6 +149,7 @@ class TemplateBuilder {
 
   HexTemplate take() {
     template_compute_child_axes(t_);
+    template_compile(t_);
     return std::move(t_);
   }
 
@@ -224,8 +225,18 @@ bool cell_map_sixths(const TemplateCell& cell, const std::array<int64_t, 3>& p6,
 }  // namespace
 
 TemplateRefiner::TemplateRefiner(const HexMesh& mesh, const HexTopology& topology)
-    : mesh_(mesh), topology_(topology), points_(mesh.points) {
-  nodes_.reserve(mesh.points.size());
+    : mesh_(mesh),
+      topology_(topology),
+      points_(mesh.points),
+      edge_slot_(5 * static_cast<size_t>(topology.edge_count()), -1),
+      face_base_(topology.face_count(), -1) {
+  // Address space only: pages are touched as faces are first used.
+  face_slot_.reserve(25 * static_cast<size_t>(topology.face_count()));
+}
+
+void TemplateRefiner::reserve_created(size_t nodes) {
+  points_.reserve(points_.size() + nodes);
+  created_keys_.reserve(created_keys_.size() + nodes);
 }
 
 TemplateCell TemplateRefiner::cell_whole(int32_t hex) const {
@@ -287,29 +298,78 @@ TemplateNodeKey TemplateRefiner::key_at(int32_t hex, const TemplateParam& p) con
   return make_key(TemplateNodeKey::interior, hex, p[0] * (kUnit + 1) + p[1], p[2]);
 }
 
+int32_t* TemplateRefiner::slot_of(const TemplateNodeKey& key) {
+  constexpr int64_t sixth = kUnit / 6;
+  const int64_t id = key.entity & 0xFFFFFFFFFF;
+  switch (key.kind()) {
+    case TemplateNodeKey::edge:
+      if (key.a % sixth == 0) return &edge_slot_[5 * id + key.a / sixth - 1];
+      return nullptr;
+    case TemplateNodeKey::face: {
+      if (key.a % sixth != 0 || key.b % sixth != 0) return nullptr;
+      int32_t& base = face_base_[id];
+      if (base < 0) {
+        base = static_cast<int32_t>(face_slot_.size());
+        face_slot_.resize(face_slot_.size() + 25, -1);
+      }
+      return &face_slot_[base + 5 * (key.a / sixth - 1) + (key.b / sixth - 1)];
+    }
+    default:
+      return nullptr;
+  }
+}
+
+const TemplateNodeKey* TemplateRefiner::alias_of(const TemplateNodeKey& key) const {
+  if (aliases_.empty()) return nullptr;
+  if (key.kind() == TemplateNodeKey::face) {
+    if (!face_aliased_[key.entity & 0xFFFFFFFFFF]) return nullptr;
+  } else if (other_aliases_ == 0) {
+    return nullptr;
+  }
+  const auto it = aliases_.find(key);
+  return it == aliases_.end() ? nullptr : &it->second;
+}
+
+int32_t TemplateRefiner::find_node(const TemplateNodeKey& key) {
+  if (key.kind() == TemplateNodeKey::corner) return static_cast<int32_t>(key.entity & 0xFFFFFFFFFF);
+  if (const int32_t* s = slot_of(key)) return *s;
+  const auto it = nodes_.find(key);
+  return it == nodes_.end() ? -1 : it->second;
+}
+
+int32_t TemplateRefiner::create_node(const TemplateNodeKey& key, const Eigen::Vector3d& x) {
+  points_.push_back(x);
+  created_keys_.push_back(key);
+  return static_cast<int32_t>(points_.size() - 1);
+}
+
 bool TemplateRefiner::alias(const TemplateNodeKey& from, const TemplateNodeKey& to) {
   // Too late if a node was already created under `from`: cells made before would keep it.
-  if (nodes_.count(from)) return false;
+  if (find_node(from) >= 0) return false;
   auto [it, inserted] = aliases_.emplace(from, to);
+  if (inserted) {
+    if (from.kind() == TemplateNodeKey::face) {
+      if (face_aliased_.empty()) face_aliased_.assign(topology_.face_count(), 0);
+      face_aliased_[from.entity & 0xFFFFFFFFFF] = 1;
+    } else {
+      ++other_aliases_;
+    }
+  }
   return inserted || it->second == to;
 }
 
 int32_t TemplateRefiner::node_of(const TemplateNodeKey& key, const Eigen::Vector3d& x,
                                  bool* aliased) {
-  TemplateNodeKey k = key;
-  if (!aliases_.empty()) {
-    const auto it = aliases_.find(key);
-    if (it != aliases_.end()) {
-      k = it->second;
-      if (aliased) *aliased = true;
-    }
-  }
+  const TemplateNodeKey* target = alias_of(key);
+  if (target && aliased) *aliased = true;
+  const TemplateNodeKey& k = target ? *target : key;
   if (k.kind() == TemplateNodeKey::corner) return static_cast<int32_t>(k.entity & 0xFFFFFFFFFF);
-  const auto [it, inserted] = nodes_.emplace(k, static_cast<int32_t>(points_.size()));
-  if (inserted) {
-    points_.push_back(x);
-    created_keys_.push_back(k);
+  if (int32_t* s = slot_of(k)) {
+    if (*s < 0) *s = create_node(k, x);
+    return *s;
   }
+  const auto [it, inserted] = nodes_.emplace(k, static_cast<int32_t>(points_.size()));
+  if (inserted) create_node(k, x);
   return it->second;
 }
 
@@ -355,13 +415,8 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
   };
   if (!cell.exact && !cell.whole) fail("a sub-hex with inexact corners cannot be refined again");
 
-  struct Placed {
-    int32_t node;
-    TemplateParam param;
-    TemplateNodeKey key;
-    bool exact, aliased;
-  };
-  std::vector<Placed> placed(t.nodes.size());
+  std::vector<Placed>& placed = placed_;
+  placed.resize(t.nodes.size());
   for (size_t i = 0; i < t.nodes.size(); ++i) {
     const TemplateNode& tn = t.nodes[i];
     const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
@@ -409,10 +464,8 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
       bool interior = true;
       for (int k = 0; k < 3; ++k) interior = interior && p[k] > 1e-12 && p[k] < 1 - 1e-12;
       if (!interior) fail("a node on the cell's boundary is off the exact grid");
-      points_.push_back(position);
-      out.node = static_cast<int32_t>(points_.size() - 1);
-      out.key = make_key(TemplateNodeKey::fresh, out.node);
-      created_keys_.push_back(out.key);
+      out.key = make_key(TemplateNodeKey::fresh, static_cast<int32_t>(points_.size()));
+      out.node = create_node(out.key, position);
       continue;
     }
     out.key = key_at(h, out.param);
@@ -459,6 +512,169 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
   }
 }
 
+void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
+                                  bool interior_private, std::vector<HexCell>& children) {
+  const HexCell& input = mesh_.hexes[h];
+  bool distinct = true;
+  for (int a = 0; a < 8; ++a)
+    for (int b = a + 1; b < 8; ++b) distinct = distinct && input[a] != input[b];
+  if (t.plans.empty() || t.plans[symmetry].generic || !distinct) {
+    std::vector<TemplateCell> cells;
+    apply(cell_whole(h), t, symmetry, cells);
+    for (const TemplateCell& c : cells) children.push_back(c.nodes);
+    return;
+  }
+  constexpr int64_t sixth = kUnit / 6;
+  const TemplatePlan& plan = t.plans[symmetry];
+  std::array<Eigen::Vector3d, 8> x;
+  for (int v = 0; v < 8; ++v) x[v] = mesh_.points[input[v]];
+  // The canonical frame of each face (as key_at): origin vertex and the u and v neighbours.
+  std::array<std::array<int8_t, 3>, 6> frame;
+  for (int lf = 0; lf < 6; ++lf) frame[lf][0] = -1;
+  const bool plain = aliases_.empty();
+  bool aliased = false;
+  placed_ids_.resize(plan.nodes.size());
+  for (size_t i = 0; i < plan.nodes.size(); ++i) {
+    const TemplatePlanNode& n = plan.nodes[i];
+    auto position = [&] {
+      Eigen::Vector3d out = Eigen::Vector3d::Zero();
+      for (int v = 0; v < 8; ++v) out += n.weight[v] * x[v];
+      return out;
+    };
+    int32_t id = -1;
+    switch (n.kind) {
+      case TemplateNodeKey::corner:
+        id = input[n.local];
+        break;
+      case TemplateNodeKey::edge: {
+        const int le = n.local;
+        const int32_t e = topology_.hex_edge_ids[h][le];
+        const int axis = hex_edge_axis[le];
+        int64_t t6 = hex_corner[hex_edges[le][0]][axis] ? 6 - n.p6[axis] : n.p6[axis];
+        if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t6 = 6 - t6;
+        if (plain) {
+          int32_t& s = edge_slot_[5 * static_cast<size_t>(e) + t6 - 1];
+          if (s < 0) s = create_node(make_key(TemplateNodeKey::edge, e, t6 * sixth), position());
+          id = s;
+        } else {
+          id = node_of(make_key(TemplateNodeKey::edge, e, t6 * sixth), position(), &aliased);
+        }
+        break;
+      }
+      case TemplateNodeKey::face: {
+        const int lf = n.local;
+        auto& fr = frame[lf];
+        if (fr[0] < 0) {
+          int i0 = 0;
+          for (int c = 1; c < 4; ++c)
+            if (input[hex_faces[lf][c]] < input[hex_faces[lf][i0]]) i0 = c;
+          const int step =
+              input[hex_faces[lf][(i0 + 1) % 4]] < input[hex_faces[lf][(i0 + 3) % 4]] ? 1 : 3;
+          fr = {static_cast<int8_t>(hex_faces[lf][i0]),
+                static_cast<int8_t>(hex_faces[lf][(i0 + step) % 4]),
+                static_cast<int8_t>(hex_faces[lf][(i0 + 3 * step) % 4])};
+        }
+        const int* o = hex_corner[fr[0]];
+        const int* c1 = hex_corner[fr[1]];
+        const int* c3 = hex_corner[fr[2]];
+        int64_t u6 = 0, v6 = 0;
+        for (int k = 0; k < 3; ++k) {
+          u6 += (c1[k] - o[k]) * (n.p6[k] - 6 * o[k]);
+          v6 += (c3[k] - o[k]) * (n.p6[k] - 6 * o[k]);
+        }
+        const int32_t f = topology_.hex_face_ids[h][lf];
+        const TemplateNodeKey key = make_key(TemplateNodeKey::face, f, u6 * sixth, v6 * sixth);
+        if (plain) {
+          int32_t& base = face_base_[f];
+          if (base < 0) {
+            base = static_cast<int32_t>(face_slot_.size());
+            face_slot_.resize(face_slot_.size() + 25, -1);
+          }
+          int32_t& s = face_slot_[base + 5 * (u6 - 1) + (v6 - 1)];
+          if (s < 0) s = create_node(key, position());
+          id = s;
+        } else {
+          id = node_of(key, position(), &aliased);
+        }
+        break;
+      }
+      default: {
+        const TemplateNodeKey key =
+            make_key(TemplateNodeKey::interior, h, n.p6[0] * sixth * (kUnit + 1) + n.p6[1] * sixth,
+                     n.p6[2] * sixth);
+        id = interior_private ? create_node(key, position()) : node_of(key, position(), &aliased);
+        break;
+      }
+    }
+    placed_ids_[i] = id;
+  }
+  if (aliased)
+    for (size_t i = 0; i < placed_ids_.size(); ++i)
+      for (size_t j = i + 1; j < placed_ids_.size(); ++j)
+        if (placed_ids_[i] == placed_ids_[j])
+          throw OperationError("hex " + std::to_string(h) + " (" + template_tag_name(t.tag) +
+                               "): two template nodes fall on one node (the cell is degenerate)");
+  for (const auto& c : plan.children) {
+    HexCell out;
+    for (int k = 0; k < 8; ++k) out[k] = placed_ids_[c[k]];
+    children.push_back(out);
+  }
+}
+
+void template_compile(HexTemplate& t) {
+  t.plans.assign(48, {});
+  for (int sym = 0; sym < 48; ++sym) {
+    const CubeSymmetry& s = cube_symmetries()[sym];
+    TemplatePlan& plan = t.plans[sym];
+    for (const TemplateNode& tn : t.nodes) {
+      TemplatePlanNode n;
+      const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
+      bool on_grid = true;
+      int extreme = 0, free_axis = -1, fixed_axis = -1;
+      for (int k = 0; k < 3; ++k) {
+        const long q = std::lround(6.0 * p[k]);
+        on_grid = on_grid && std::abs(6.0 * p[k] - double(q)) < 1e-9;
+        n.p6[k] = static_cast<int8_t>(q);
+        if (q == 0 || q == 6) {
+          ++extreme;
+          fixed_axis = k;
+        } else {
+          free_axis = k;
+        }
+      }
+      // The same weights as the generic path's trilinear(x, param / unit).
+      for (int v = 0; v < 8; ++v) {
+        double w = 1.0;
+        for (int k = 0; k < 3; ++k) {
+          const double r = double(n.p6[k] * (kUnit / 6)) / kUnit;
+          w *= hex_corner[v][k] ? r : 1.0 - r;
+        }
+        n.weight[v] = w;
+      }
+      if (tn.adjustment_edge >= 0 || !on_grid) {
+        plan.generic = true;
+      } else if (extreme == 3) {
+        n.kind = TemplateNodeKey::corner;
+        n.local = static_cast<int8_t>(vertex_of({n.p6[0] / 6, n.p6[1] / 6, n.p6[2] / 6}));
+      } else if (extreme == 2) {
+        n.kind = TemplateNodeKey::edge;
+        n.local = static_cast<int8_t>(
+            local_edge_at({n.p6[0] / 6.0, n.p6[1] / 6.0, n.p6[2] / 6.0}, free_axis));
+      } else if (extreme == 1) {
+        n.kind = TemplateNodeKey::face;
+        n.local = static_cast<int8_t>(2 * fixed_axis + (n.p6[fixed_axis] == 6 ? 1 : 0));
+      } else {
+        n.kind = TemplateNodeKey::interior;
+      }
+      plan.nodes.push_back(n);
+    }
+    for (std::array<int16_t, 8> c : t.children) {
+      if (s.reflection) c = {c[0], c[3], c[2], c[1], c[4], c[7], c[6], c[5]};
+      plan.children.push_back(c);
+    }
+  }
+}
+
 TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topology,
                                     std::span<const TemplateApplication> applications,
                                     std::span<const TemplateFaceAlias> aliases) {
@@ -480,9 +696,14 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
 
   TemplateApplyResult out;
   HexMesh& res = out.mesh;
-  res.hexes.reserve(mesh.hexes.size());
-  out.parent.reserve(mesh.hexes.size());
-  std::vector<TemplateCell> children;
+  size_t out_hexes = mesh.hexes.size(), new_nodes = 0;
+  for (const TemplateApplication& a : applications) {
+    out_hexes += a.tmpl->children.size() - 1;
+    new_nodes += a.tmpl->nodes.size();
+  }
+  res.hexes.reserve(out_hexes);
+  out.parent.reserve(out_hexes);
+  refiner.reserve_created(new_nodes);
   for (int32_t h = 0; h < nh; ++h) {
     const int32_t a = application_of[h];
     if (a < 0) {
@@ -490,18 +711,14 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
       out.parent.push_back(h);
       continue;
     }
-    children.clear();
+    const size_t before = res.hexes.size();
     try {
-      refiner.apply(refiner.cell_whole(h), *applications[a].tmpl, applications[a].symmetry,
-                    children);
+      refiner.apply_whole(h, *applications[a].tmpl, applications[a].symmetry, true, res.hexes);
     } catch (const OperationError& e) {
       throw OperationError(std::string("templates_apply: ") + e.what());
     }
-    for (const TemplateCell& c : children) {
-      res.hexes.push_back(c.nodes);
-      out.parent.push_back(h);
-    }
-    out.hexes_created += static_cast<int64_t>(children.size());
+    out.parent.resize(res.hexes.size(), h);
+    out.hexes_created += static_cast<int64_t>(res.hexes.size() - before);
     out.hexes_deleted += 1;
   }
   res.points = std::move(refiner.points());
@@ -599,6 +816,7 @@ const HexTemplate& template_1_27() {
                                 id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
                                 id(i, j + 1, k + 1)});
     template_compute_child_axes(r);
+    template_compile(r);
     return r;
   }();
   return t;
@@ -617,6 +835,7 @@ const HexTemplate& template_1_3() {
       r.children.push_back({id(i, 0, 0), id(i + 1, 0, 0), id(i + 1, 1, 0), id(i, 1, 0), id(i, 0, 1),
                             id(i + 1, 0, 1), id(i + 1, 1, 1), id(i, 1, 1)});
     template_compute_child_axes(r);
+    template_compile(r);
     return r;
   }();
   return t;

@@ -30,6 +30,11 @@ enum class TemplateTag : int32_t {
 /// Short name used in reports ("1-27", "1-3-adj1", ...).
 const char* template_tag_name(TemplateTag tag);
 
+struct RefineStats;
+/// Fills stats.hexes_per_template from a list of per-hex template tags (values outside the
+/// enumeration are counted under template_tag_name's name for them).
+void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags);
+
 /// The hexes selected for refinement: ascending, unique ids into the input mesh.
 struct Targets {
   std::vector<int32_t> hexes;

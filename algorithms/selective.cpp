@@ -266,6 +266,11 @@ class SelectivePass {
   /// A hex with split mask `mask` is refined directionally: no template matches, or it was forced
   /// (its element-by-element children would invert).
   bool is_directional(int32_t h, uint16_t mask) const;
+  /// Directional, or refined by an adjusted template: conformity is checked around it.
+  bool hex_is_risky(int32_t h) const {
+    return role_[h] == kDirectional ||
+           (role_[h] == kElement && template_is_adjusted(element_choice_[h].tmpl));
+  }
 
   const HexMesh& mesh_;
   const std::vector<int32_t>& targets_;
@@ -766,9 +771,7 @@ void SelectivePass::check_output(const PassOutput& out) const {
   std::vector<uint8_t> in_region(nh, 0);
   bool any_risky = false;
   for (int32_t h = 0; h < nh; ++h) {
-    const bool risky = role_[h] == kDirectional ||
-                       (role_[h] == kElement && template_is_adjusted(element_choice_[h].tmpl));
-    if (!risky) continue;
+    if (!hex_is_risky(h)) continue;
     any_risky = true;
     in_region[h] = 1;
     for (int lf = 0; lf < 6; ++lf) {
@@ -935,7 +938,7 @@ PassOutput SelectivePass::run() {
   PassOutput out;
   out.role = role_;
   HexMesh& res = out.mesh;
-  std::vector<int32_t> tags;
+  std::vector<int32_t> parent_tag(mesh_.hex_count(), -1);  // tag of a refined input hex
   const int32_t nh = mesh_.hex_count();
   size_t out_hexes = 0, new_nodes = 0;
   for (int32_t h = 0; h < nh; ++h) {
@@ -949,7 +952,10 @@ PassOutput SelectivePass::run() {
   }
   res.hexes.reserve(out_hexes);
   out.parent.reserve(out_hexes);
-  tags.reserve(out_hexes);
+  // Node keys are needed only by the self-check around risky hexes (check_region).
+  bool any_risky = false;
+  for (int32_t h = 0; h < nh; ++h) any_risky = any_risky || hex_is_risky(h);
+  if (!any_risky) refiner_->set_record_keys(false);
   refiner_->reserve_created(new_nodes);
   for (int32_t h = 0; h < nh; ++h) {
     const size_t before = res.hexes.size();
@@ -973,11 +979,10 @@ PassOutput SelectivePass::run() {
     if (res.hexes.size() == before) {
       res.hexes.push_back(mesh_.hexes[h]);
       out.parent.push_back(h);
-      tags.push_back(-1);
       continue;
     }
     out.parent.resize(res.hexes.size(), h);
-    tags.resize(res.hexes.size(), static_cast<int32_t>(tag));
+    parent_tag[h] = static_cast<int32_t>(tag);
     stats_.hexes_created += static_cast<int64_t>(res.hexes.size() - before);
     stats_.hexes_deleted += 1;
   }
@@ -990,10 +995,10 @@ PassOutput SelectivePass::run() {
   const std::vector<int32_t>* in_level = mesh_find_attribute(mesh_, attribute_refinement_level);
   std::vector<int32_t> level(res.hexes.size());
   for (size_t i = 0; i < res.hexes.size(); ++i)
-    level[i] = (in_level ? (*in_level)[out.parent[i]] : 0) + (tags[i] >= 0 ? 1 : 0);
+    level[i] = (in_level ? (*in_level)[out.parent[i]] : 0) + (parent_tag[out.parent[i]] >= 0);
   std::vector<int32_t>& tag_attr = mesh_attribute(res, attribute_template_tag, 0);
   for (size_t i = 0; i < res.hexes.size(); ++i)
-    if (tags[i] >= 0) tag_attr[i] = tags[i];
+    if (parent_tag[out.parent[i]] >= 0) tag_attr[i] = parent_tag[out.parent[i]];
   mesh_attribute(res, attribute_refinement_level, 0) = std::move(level);
   stats_.phase_seconds["assembly"] += seconds_since(t4);
 
@@ -1078,9 +1083,7 @@ RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
   result.mesh = std::move(current);
   stats.final_hexes = result.mesh.hex_count();
   stats.final_nodes = result.mesh.point_count();
-  const auto* tag = mesh_find_attribute(result.mesh, attribute_template_tag);
-  for (int32_t h = 0; h < result.mesh.hex_count(); ++h)
-    ++stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(tag ? (*tag)[h] : 0))];
+  stats_count_templates(stats, mesh_attribute(result.mesh, attribute_template_tag, 0));
   stats.time_seconds = seconds_since(t0);
   stats.phase_seconds["total"] = stats.time_seconds;
   return result;

@@ -745,8 +745,7 @@ RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const Ref
 
   stats.final_hexes = result.mesh.hex_count();
   stats.final_nodes = result.mesh.point_count();
-  for (int32_t tag : *mesh_find_attribute(result.mesh, attribute_template_tag))
-    ++stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(tag))];
+  stats_count_templates(stats, *mesh_find_attribute(result.mesh, attribute_template_tag));
   stats.time_seconds = seconds_since(t0);
   stats.phase_seconds["total"] = stats.time_seconds;
   return result;

@@ -228,15 +228,15 @@ TemplateRefiner::TemplateRefiner(const HexMesh& mesh, const HexTopology& topolog
     : mesh_(mesh),
       topology_(topology),
       points_(mesh.points),
-      edge_slot_(5 * static_cast<size_t>(topology.edge_count()), -1),
+      edge_slot_(3 * static_cast<size_t>(topology.edge_count()), -1),
       face_base_(topology.face_count(), -1) {
   // Address space only: pages are touched as faces are first used.
-  face_slot_.reserve(25 * static_cast<size_t>(topology.face_count()));
+  face_slot_.reserve(9 * static_cast<size_t>(topology.face_count()));
 }
 
 void TemplateRefiner::reserve_created(size_t nodes) {
   points_.reserve(points_.size() + nodes);
-  created_keys_.reserve(created_keys_.size() + nodes);
+  if (record_keys_) created_keys_.reserve(created_keys_.size() + nodes);
 }
 
 TemplateCell TemplateRefiner::cell_whole(int32_t hex) const {
@@ -299,20 +299,30 @@ TemplateNodeKey TemplateRefiner::key_at(int32_t hex, const TemplateParam& p) con
 }
 
 int32_t* TemplateRefiner::slot_of(const TemplateNodeKey& key) {
+  // Slots cover the positions templates use on whole hexes and on the first level of
+  // sub-cells: thirds and halves (sixths 2, 3, 4) along an edge and in both directions of a
+  // face. 1/6 and 5/6 occur only deeper or at adjustments and go to the hash table.
   constexpr int64_t sixth = kUnit / 6;
+  auto index = [](int64_t x) -> int {
+    if (x % sixth != 0) return -1;
+    const int64_t i = x / sixth - 2;
+    return i >= 0 && i < 3 ? static_cast<int>(i) : -1;
+  };
   const int64_t id = key.entity & 0xFFFFFFFFFF;
   switch (key.kind()) {
-    case TemplateNodeKey::edge:
-      if (key.a % sixth == 0) return &edge_slot_[5 * id + key.a / sixth - 1];
-      return nullptr;
+    case TemplateNodeKey::edge: {
+      const int i = index(key.a);
+      return i < 0 ? nullptr : &edge_slot_[3 * id + i];
+    }
     case TemplateNodeKey::face: {
-      if (key.a % sixth != 0 || key.b % sixth != 0) return nullptr;
+      const int i = index(key.a), j = index(key.b);
+      if (i < 0 || j < 0) return nullptr;
       int32_t& base = face_base_[id];
       if (base < 0) {
         base = static_cast<int32_t>(face_slot_.size());
-        face_slot_.resize(face_slot_.size() + 25, -1);
+        face_slot_.resize(face_slot_.size() + 9, -1);
       }
-      return &face_slot_[base + 5 * (key.a / sixth - 1) + (key.b / sixth - 1)];
+      return &face_slot_[base + 3 * i + j];
     }
     default:
       return nullptr;
@@ -339,7 +349,7 @@ int32_t TemplateRefiner::find_node(const TemplateNodeKey& key) {
 
 int32_t TemplateRefiner::create_node(const TemplateNodeKey& key, const Eigen::Vector3d& x) {
   points_.push_back(x);
-  created_keys_.push_back(key);
+  if (record_keys_) created_keys_.push_back(key);
   return static_cast<int32_t>(points_.size() - 1);
 }
 
@@ -360,16 +370,23 @@ bool TemplateRefiner::alias(const TemplateNodeKey& from, const TemplateNodeKey& 
 
 int32_t TemplateRefiner::node_of(const TemplateNodeKey& key, const Eigen::Vector3d& x,
                                  bool* aliased) {
+  return node_at(
+      key, [&] { return x; }, aliased);
+}
+
+template <class Position>
+int32_t TemplateRefiner::node_at(const TemplateNodeKey& key, const Position& position,
+                                 bool* aliased) {
   const TemplateNodeKey* target = alias_of(key);
   if (target && aliased) *aliased = true;
   const TemplateNodeKey& k = target ? *target : key;
   if (k.kind() == TemplateNodeKey::corner) return static_cast<int32_t>(k.entity & 0xFFFFFFFFFF);
   if (int32_t* s = slot_of(k)) {
-    if (*s < 0) *s = create_node(k, x);
+    if (*s < 0) *s = create_node(k, position());
     return *s;
   }
   const auto [it, inserted] = nodes_.emplace(k, static_cast<int32_t>(points_.size()));
-  if (inserted) create_node(k, x);
+  if (inserted) create_node(k, position());
   return it->second;
 }
 
@@ -524,14 +541,12 @@ void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
     for (const TemplateCell& c : cells) children.push_back(c.nodes);
     return;
   }
-  constexpr int64_t sixth = kUnit / 6;
   const TemplatePlan& plan = t.plans[symmetry];
   std::array<Eigen::Vector3d, 8> x;
   for (int v = 0; v < 8; ++v) x[v] = mesh_.points[input[v]];
   // The canonical frame of each face (as key_at): origin vertex and the u and v neighbours.
   std::array<std::array<int8_t, 3>, 6> frame;
   for (int lf = 0; lf < 6; ++lf) frame[lf][0] = -1;
-  const bool plain = aliases_.empty();
   bool aliased = false;
   placed_ids_.resize(plan.nodes.size());
   for (size_t i = 0; i < plan.nodes.size(); ++i) {
@@ -550,15 +565,9 @@ void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
         const int le = n.local;
         const int32_t e = topology_.hex_edge_ids[h][le];
         const int axis = hex_edge_axis[le];
-        int64_t t6 = hex_corner[hex_edges[le][0]][axis] ? 6 - n.p6[axis] : n.p6[axis];
-        if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t6 = 6 - t6;
-        if (plain) {
-          int32_t& s = edge_slot_[5 * static_cast<size_t>(e) + t6 - 1];
-          if (s < 0) s = create_node(make_key(TemplateNodeKey::edge, e, t6 * sixth), position());
-          id = s;
-        } else {
-          id = node_of(make_key(TemplateNodeKey::edge, e, t6 * sixth), position(), &aliased);
-        }
+        int64_t t = hex_corner[hex_edges[le][0]][axis] ? kUnit - n.param[axis] : n.param[axis];
+        if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t = kUnit - t;
+        id = node_at(make_key(TemplateNodeKey::edge, e, t), position, &aliased);
         break;
       }
       case TemplateNodeKey::face: {
@@ -577,32 +586,20 @@ void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
         const int* o = hex_corner[fr[0]];
         const int* c1 = hex_corner[fr[1]];
         const int* c3 = hex_corner[fr[2]];
-        int64_t u6 = 0, v6 = 0;
+        int64_t u = 0, v = 0;
         for (int k = 0; k < 3; ++k) {
-          u6 += (c1[k] - o[k]) * (n.p6[k] - 6 * o[k]);
-          v6 += (c3[k] - o[k]) * (n.p6[k] - 6 * o[k]);
+          u += (c1[k] - o[k]) * (n.param[k] - o[k] * kUnit);
+          v += (c3[k] - o[k]) * (n.param[k] - o[k] * kUnit);
         }
         const int32_t f = topology_.hex_face_ids[h][lf];
-        const TemplateNodeKey key = make_key(TemplateNodeKey::face, f, u6 * sixth, v6 * sixth);
-        if (plain) {
-          int32_t& base = face_base_[f];
-          if (base < 0) {
-            base = static_cast<int32_t>(face_slot_.size());
-            face_slot_.resize(face_slot_.size() + 25, -1);
-          }
-          int32_t& s = face_slot_[base + 5 * (u6 - 1) + (v6 - 1)];
-          if (s < 0) s = create_node(key, position());
-          id = s;
-        } else {
-          id = node_of(key, position(), &aliased);
-        }
+        id = node_at(make_key(TemplateNodeKey::face, f, u, v), position, &aliased);
         break;
       }
       default: {
         const TemplateNodeKey key =
-            make_key(TemplateNodeKey::interior, h, n.p6[0] * sixth * (kUnit + 1) + n.p6[1] * sixth,
-                     n.p6[2] * sixth);
-        id = interior_private ? create_node(key, position()) : node_of(key, position(), &aliased);
+            make_key(TemplateNodeKey::interior, h, n.param[0] * (kUnit + 1) + n.param[1],
+                     n.param[2]);
+        id = interior_private ? create_node(key, position()) : node_at(key, position, &aliased);
         break;
       }
     }
@@ -629,13 +626,16 @@ void template_compile(HexTemplate& t) {
     for (const TemplateNode& tn : t.nodes) {
       TemplatePlanNode n;
       const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
+      // Exact positions: multiples of 1 / template_param_unit (thirds and sixths of the
+      // standard templates, and the finer positions of composites built from them).
       bool on_grid = true;
       int extreme = 0, free_axis = -1, fixed_axis = -1;
       for (int k = 0; k < 3; ++k) {
-        const long q = std::lround(6.0 * p[k]);
-        on_grid = on_grid && std::abs(6.0 * p[k] - double(q)) < 1e-9;
-        n.p6[k] = static_cast<int8_t>(q);
-        if (q == 0 || q == 6) {
+        const double scaled = p[k] * double(kUnit);
+        const int64_t q = std::llround(scaled);
+        on_grid = on_grid && std::abs(scaled - double(q)) < 1e-3 && q >= 0 && q <= kUnit;
+        n.param[k] = q;
+        if (q == 0 || q == kUnit) {
           ++extreme;
           fixed_axis = k;
         } else {
@@ -646,7 +646,7 @@ void template_compile(HexTemplate& t) {
       for (int v = 0; v < 8; ++v) {
         double w = 1.0;
         for (int k = 0; k < 3; ++k) {
-          const double r = double(n.p6[k] * (kUnit / 6)) / kUnit;
+          const double r = double(n.param[k]) / kUnit;
           w *= hex_corner[v][k] ? r : 1.0 - r;
         }
         n.weight[v] = w;
@@ -655,14 +655,17 @@ void template_compile(HexTemplate& t) {
         plan.generic = true;
       } else if (extreme == 3) {
         n.kind = TemplateNodeKey::corner;
-        n.local = static_cast<int8_t>(vertex_of({n.p6[0] / 6, n.p6[1] / 6, n.p6[2] / 6}));
+        n.local = static_cast<int8_t>(vertex_of(
+            {int(n.param[0] / kUnit), int(n.param[1] / kUnit), int(n.param[2] / kUnit)}));
       } else if (extreme == 2) {
         n.kind = TemplateNodeKey::edge;
         n.local = static_cast<int8_t>(
-            local_edge_at({n.p6[0] / 6.0, n.p6[1] / 6.0, n.p6[2] / 6.0}, free_axis));
+            local_edge_at({double(n.param[0] / kUnit), double(n.param[1] / kUnit),
+                           double(n.param[2] / kUnit)},
+                          free_axis));
       } else if (extreme == 1) {
         n.kind = TemplateNodeKey::face;
-        n.local = static_cast<int8_t>(2 * fixed_axis + (n.p6[fixed_axis] == 6 ? 1 : 0));
+        n.local = static_cast<int8_t>(2 * fixed_axis + (n.param[fixed_axis] == kUnit ? 1 : 0));
       } else {
         n.kind = TemplateNodeKey::interior;
       }

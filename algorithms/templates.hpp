@@ -22,11 +22,11 @@
 /// nodes and conformity holds by construction. Nodes are positioned by the input hex's trilinear
 /// map at their exact position; on a shared face both hexes' maps agree (the bilinear face map).
 /// Node lookup (TemplateRefiner) goes through flat slot arrays wherever a key lies on the
-/// sixths grid of its entity: five slots per input edge, 25 per input face (allocated on first
-/// use). Only keys off that grid (sub-cells nested deeper, adjustment nodes) and interior nodes
-/// shared by sub-cells go to a hash table. Templates are compiled once per cube symmetry
-/// (TemplatePlan) so that refining a whole input hex is a table walk: no per-node search, no
-/// allocation, no hash lookup.
+/// thirds-and-halves grid of its entity: three slots per input edge, nine per input face
+/// (allocated on first use). Only keys off that grid (sub-cells nested deeper, adjustment nodes)
+/// and interior nodes shared by sub-cells go to a hash table. Templates are compiled once per cube
+/// symmetry (TemplatePlan) so that refining a whole input hex is a table walk: no per-node search,
+/// no allocation, no hash lookup.
 
 #include <array>
 #include <cstdint>
@@ -55,7 +55,7 @@ struct TemplatePlanNode {
   /// generic path (an adjustment node, or a position off the sixths grid).
   int8_t kind = -1;
   int8_t local = -1;               ///< local vertex, edge or face of the hex (by kind)
-  std::array<int8_t, 3> p6{};      ///< position in the hex's reference cube, in sixths
+  std::array<int64_t, 3> param{};  ///< exact position in the hex's cube (template_param_unit)
   std::array<double, 8> weight{};  ///< trilinear weights of the hex corners at that position
 };
 
@@ -233,8 +233,13 @@ class TemplateRefiner {
   TemplateNodeKey key_of_template_node(const TemplateCell& cell, int symmetry,
                                        const TemplateNode& node) const;
 
-  /// Key of every node created so far, indexed by node id - input point count.
+  /// Key of every node created so far, indexed by node id - input point count (while
+  /// record_keys is on, the default).
   const std::vector<TemplateNodeKey>& created_keys() const { return created_keys_; }
+  /// Switches recording created_keys off (or on again): saves 24 bytes per node when no one
+  /// asks for the keys. Precondition for switching off: no node created yet, or the keys
+  /// recorded so far are not needed.
+  void set_record_keys(bool on) { record_keys_ = on; }
 
   /// Key adjustment nodes of whole cells by their exact position inside the hex (like those of
   /// sub-cells) instead of by (edge, index): needed when the cells around an adjustment are
@@ -251,6 +256,9 @@ class TemplateRefiner {
 
  private:
   int32_t node_of(const TemplateNodeKey& key, const Eigen::Vector3d& x, bool* aliased);
+  /// node_of with the position computed (position()) only if the node is created.
+  template <class Position>
+  int32_t node_at(const TemplateNodeKey& key, const Position& position, bool* aliased);
   /// The slot array entry of a key on the sixths grid of an edge or a face, or nullptr (the
   /// key is looked up in the hash table). The pointer is valid until the next slot call.
   int32_t* slot_of(const TemplateNodeKey& key);
@@ -263,9 +271,10 @@ class TemplateRefiner {
   std::vector<Eigen::Vector3d> points_;
   std::vector<TemplateNodeKey> created_keys_;
   bool adjustment_by_position_ = false;
-  std::vector<int32_t> edge_slot_;     ///< 5 per input edge: sixths 1..5 in the edge's direction
+  bool record_keys_ = true;
+  std::vector<int32_t> edge_slot_;     ///< 3 per input edge: sixths 2, 3, 4 in the edge's direction
   std::vector<int32_t> face_base_;     ///< per input face: offset into face_slot_, or -1
-  std::vector<int32_t> face_slot_;     ///< 25 per used face: (u6 - 1) * 5 + (v6 - 1)
+  std::vector<int32_t> face_slot_;     ///< 9 per used face: (u6 - 2) * 3 + (v6 - 2), u6, v6 in 2..4
   std::vector<uint8_t> face_aliased_;  ///< per input face: some key on it is aliased
   int64_t other_aliases_ = 0;          ///< aliases whose source is not a face key
   std::unordered_map<TemplateNodeKey, int32_t, TemplateNodeKeyHash> nodes_;

@@ -7,18 +7,22 @@
 /// (UseRealTime). Counters: final hexes, hexes created and deleted, sheet passes, added targets,
 /// per-phase seconds (of the last iteration), and `s/initial_hex` (seconds per input hex; flat
 /// when the time grows linearly), `hexes_in/s` and `hexes_out/s` (initial and final hexes per
-/// second) and `peak_rss_MB` (the benchmark's peak resident memory, VmHWM, reset at its start).
-/// Sizes: 10, 25, 50; 10 only under HEXREFINE_BENCH_SMOKE=1 (`hexrefine bench --smoke`); 75 (the
-/// thesis' largest brick: about 6 GB, tens of seconds) only under HEXREFINE_BENCH_LARGE=1.
-/// A refiner that throws (e.g. not implemented yet) is reported
-/// as a skipped benchmark with its message.
+/// second), `output_MB`, `floor_s` and `floor_ratio` (the time to write the output's bytes into
+/// fresh memory in the same run, and our median time over it) and `peak_rss_MB` (the benchmark's
+/// peak resident memory, VmHWM, reset at its start). Sizes: 10, 25, 50; 10 only under
+/// HEXREFINE_BENCH_SMOKE=1 (`hexrefine bench --smoke`); 75 (the thesis' largest brick: about 6 GB,
+/// tens of seconds) only under HEXREFINE_BENCH_LARGE=1. A refiner that throws (e.g. not implemented
+/// yet) is reported as a skipped benchmark with its message.
 ///
 /// Run (Release): bench_refiners --benchmark_repetitions=3
 ///   --benchmark_out=results/benchmarks/refiners.json --benchmark_out_format=json
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstring>
 #include <exception>
+#include <memory>
 #include <string>
 
 #include "algorithms/selective.hpp"
@@ -79,10 +83,14 @@ void run(benchmark::State& state, RefineFunction refine, const HexMesh& mesh,
          const Targets& targets, const RefineOptions& options = {}) {
   RefineStats last;
   bench_reset_peak_memory();
+  std::vector<double> seconds;
   try {
     for (auto _ : state) {
+      const auto t0 = std::chrono::steady_clock::now();
       RefineResult r = refine(mesh, targets, options);
       benchmark::DoNotOptimize(r.mesh.hexes.data());
+      seconds.push_back(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       last = std::move(r.stats);
     }
   } catch (const std::exception& e) {
@@ -104,6 +112,24 @@ void run(benchmark::State& state, RefineFunction refine, const HexMesh& mesh,
   bench_set_hex_rate(state, "hexes_in/s", static_cast<double>(mesh.hex_count()));
   bench_set_hex_rate(state, "hexes_out/s", static_cast<double>(last.final_hexes));
   bench_set_peak_memory(state);
+  // The floor: writing the output's bytes (hexes and nodes) into fresh memory, page faults
+  // included, timed in the same process; floor_ratio = median refine time / median floor time.
+  const size_t bytes = static_cast<size_t>(last.final_hexes) * sizeof(HexCell) +
+                       static_cast<size_t>(last.final_nodes) * sizeof(Eigen::Vector3d);
+  std::vector<double> floor;
+  for (int rep = 0; rep < 3; ++rep) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::unique_ptr<char[]> fresh(new char[bytes]);
+    std::memset(fresh.get(), 0x5a, bytes);
+    benchmark::DoNotOptimize(fresh.get());
+    floor.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(seconds.begin(), seconds.end());
+  std::sort(floor.begin(), floor.end());
+  state.counters["output_MB"] = static_cast<double>(bytes) / 1e6;
+  state.counters["floor_s"] = floor[1];
+  if (!seconds.empty() && floor[1] > 0)
+    state.counters["floor_ratio"] = seconds[seconds.size() / 2] / floor[1];
 }
 
 void bench_full_brick(benchmark::State& state, RefineFunction refine) {

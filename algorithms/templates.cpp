@@ -596,9 +596,8 @@ void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
         break;
       }
       default: {
-        const TemplateNodeKey key =
-            make_key(TemplateNodeKey::interior, h, n.param[0] * (kUnit + 1) + n.param[1],
-                     n.param[2]);
+        const TemplateNodeKey key = make_key(TemplateNodeKey::interior, h,
+                                             n.param[0] * (kUnit + 1) + n.param[1], n.param[2]);
         id = interior_private ? create_node(key, position()) : node_at(key, position, &aliased);
         break;
       }
@@ -655,14 +654,13 @@ void template_compile(HexTemplate& t) {
         plan.generic = true;
       } else if (extreme == 3) {
         n.kind = TemplateNodeKey::corner;
-        n.local = static_cast<int8_t>(vertex_of(
-            {int(n.param[0] / kUnit), int(n.param[1] / kUnit), int(n.param[2] / kUnit)}));
+        n.local = static_cast<int8_t>(
+            vertex_of({int(n.param[0] / kUnit), int(n.param[1] / kUnit), int(n.param[2] / kUnit)}));
       } else if (extreme == 2) {
         n.kind = TemplateNodeKey::edge;
-        n.local = static_cast<int8_t>(
-            local_edge_at({double(n.param[0] / kUnit), double(n.param[1] / kUnit),
-                           double(n.param[2] / kUnit)},
-                          free_axis));
+        n.local = static_cast<int8_t>(local_edge_at(
+            {double(n.param[0] / kUnit), double(n.param[1] / kUnit), double(n.param[2] / kUnit)},
+            free_axis));
       } else if (extreme == 1) {
         n.kind = TemplateNodeKey::face;
         n.local = static_cast<int8_t>(2 * fixed_axis + (n.param[fixed_axis] == kUnit ? 1 : 0));

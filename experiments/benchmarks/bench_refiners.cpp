@@ -175,12 +175,22 @@ RefineResult sheet_one_per_pass(const HexMesh& mesh, const Targets& targets,
   return sheet_refine(mesh, targets, options, control);
 }
 
+// The rounds on the whole refined region, every intermediate mesh and topology built (the
+// default replays each hex configuration once as a composite template: same mesh).
+RefineResult sheet_rounds(const HexMesh& mesh, const Targets& targets,
+                          const RefineOptions& options) {
+  SheetControl control;
+  control.composites = false;
+  return sheet_refine(mesh, targets, options, control);
+}
+
 void sizes(benchmark::internal::Benchmark* b) {
   bench_brick_sizes(b, 10, 10);
 }
 
 BENCHMARK_CAPTURE(bench_full_brick, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, selective, selective)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_full_brick, sheet_rounds, &sheet_rounds)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, sheet_one_per_pass, &sheet_one_per_pass)
     ->Apply([](benchmark::internal::Benchmark* b) {
       if (bench_smoke())
@@ -191,6 +201,7 @@ BENCHMARK_CAPTURE(bench_full_brick, sheet_one_per_pass, &sheet_one_per_pass)
     });
 BENCHMARK_CAPTURE(bench_radial, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_radial, selective, selective)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_radial, sheet_rounds, &sheet_rounds)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_l_shaped, sheet, sheet)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(bench_l_shaped, selective, selective)
     ->Unit(benchmark::kMillisecond)

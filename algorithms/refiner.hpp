@@ -47,6 +47,10 @@ struct RefineOptions {
   int passes = 1;           ///< Refine the region this many times.
   bool buffer = false;      ///< Add the previous pass's transition layer to the next targets.
   bool allow_inverted = false;
+  /// Threads for applying whole-hex templates (the assembly of the output). The output is
+  /// identical for every count: node ids are claimed in hex order first, then the positions
+  /// and children are written in parallel. 1: everything in the calling thread.
+  int threads = 1;
 };
 
 /// Statistics of one refinement. Fields a method does not use stay zero.

@@ -957,35 +957,40 @@ PassOutput SelectivePass::run() {
   for (int32_t h = 0; h < nh; ++h) any_risky = any_risky || hex_is_risky(h);
   if (!any_risky) refiner_->set_record_keys(false);
   refiner_->reserve_created(new_nodes);
+  // Untouched hexes and directional cells are copied; targets and element-by-element hexes get
+  // one whole-hex application each (their interior nodes are private to them), in hex order,
+  // through the batch (parallel with options.threads, the same output).
+  std::vector<TemplateApplication> apps;
+  std::vector<size_t> offsets;
+  res.hexes.resize(out_hexes);
+  out.parent.resize(out_hexes);
+  size_t at = 0;
   for (int32_t h = 0; h < nh; ++h) {
-    const size_t before = res.hexes.size();
+    const size_t before = at;
     TemplateTag tag = TemplateTag::untouched;
-    // Targets and element-by-element hexes get one application each: their interior nodes are
-    // private to them.
-    if (role_[h] == kTarget) {
-      refiner_->apply_whole(h, template_1_27(), 0, true, res.hexes);
-      tag = TemplateTag::t1_27;
-    } else if (role_[h] == kElement) {
-      refiner_->apply_whole(h, *element_choice_[h].tmpl, element_choice_[h].symmetry, true,
-                            res.hexes);
-      tag = element_choice_[h].tmpl->tag;
+    if (role_[h] == kTarget || role_[h] == kElement) {
+      const TemplateChoice c =
+          role_[h] == kTarget ? TemplateChoice{&template_1_27(), 0} : element_choice_[h];
+      apps.push_back({h, c.tmpl, c.symmetry});
+      offsets.push_back(at);
+      at += c.tmpl->children.size();
+      tag = c.tmpl->tag;
     } else if (role_[h] == kDirectional) {
       const auto& cells = cells_[directional_index_[h]];
       if (cells.size() > 1 || !cells[0].whole) {
-        for (const TemplateCell& c : cells) res.hexes.push_back(c.nodes);
+        for (const TemplateCell& c : cells) res.hexes[at++] = c.nodes;
         tag = TemplateTag::directional;
       }
     }
-    if (res.hexes.size() == before) {
-      res.hexes.push_back(mesh_.hexes[h]);
-      out.parent.push_back(h);
-      continue;
-    }
-    out.parent.resize(res.hexes.size(), h);
+    if (at == before) res.hexes[at++] = mesh_.hexes[h];
+    std::fill(out.parent.begin() + static_cast<std::ptrdiff_t>(before),
+              out.parent.begin() + static_cast<std::ptrdiff_t>(at), h);
+    if (tag == TemplateTag::untouched) continue;
     parent_tag[h] = static_cast<int32_t>(tag);
-    stats_.hexes_created += static_cast<int64_t>(res.hexes.size() - before);
+    stats_.hexes_created += static_cast<int64_t>(at - before);
     stats_.hexes_deleted += 1;
   }
+  refiner_->apply_whole_batch(apps, offsets, res.hexes, options_.threads);
   res.points = std::move(refiner_->points());
   for (const HexAttribute& attr : mesh_.attributes) {
     HexAttribute copy{attr.name, std::vector<int32_t>(res.hexes.size())};
@@ -1031,7 +1036,10 @@ RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
                        " inverted hexes, first at id " + std::to_string(first));
   }
   std::vector<int32_t> current_targets = targets.hexes;
-  HexMesh current = mesh;
+  // The mesh a pass refines: the input for the first pass (not copied), the previous pass's
+  // output after that.
+  HexMesh current;
+  const HexMesh* source = &mesh;
   for (int pass = 0; pass < options.passes; ++pass) {
     // A pass that meets an adjustment it can only avoid by splitting an input edge starts
     // again with that edge split (each attempt splits one more edge, so this ends).
@@ -1041,13 +1049,13 @@ RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
     const RefineStats before = stats;
     for (;;) {
       try {
-        SelectivePass p(current, current_targets, options, stats, forced, forced_directional);
+        SelectivePass p(*source, current_targets, options, stats, forced, forced_directional);
         out = p.run();
         break;
       } catch (const DirectionalFallbackNeeded& need) {
         // Distorted hexes whose element-by-element children would invert: refine them
         // directionally instead (each attempt forces at least one more hex, so this ends).
-        if (forced_directional.empty()) forced_directional.assign(current.hex_count(), 0);
+        if (forced_directional.empty()) forced_directional.assign(source->hex_count(), 0);
         bool progress = false;
         for (int32_t h : need.hexes) {
           progress = progress || !forced_directional[h];
@@ -1078,6 +1086,7 @@ RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
       }
     }
     current = std::move(out.mesh);
+    source = &current;
     current_targets = std::move(next);
   }
   result.mesh = std::move(current);

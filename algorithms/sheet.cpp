@@ -687,7 +687,7 @@ PassOutput refine_composites(const HexMesh& mesh, const HexTopology& topology,
                              "split its edges in different passes)");
     }
   }
-  TemplateApplyResult applied = templates_apply(mesh, topology, apps);
+  TemplateApplyResult applied = templates_apply(mesh, topology, apps, {}, options.threads);
   if (!options.allow_inverted) {
     std::vector<uint8_t> check(mesh.hexes.size(), 0);
     for (size_t i = 0; i < region_hexes.size(); ++i) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
@@ -561,40 +562,10 @@ void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
       case TemplateNodeKey::corner:
         id = input[n.local];
         break;
-      case TemplateNodeKey::edge: {
-        const int le = n.local;
-        const int32_t e = topology_.hex_edge_ids[h][le];
-        const int axis = hex_edge_axis[le];
-        int64_t t = hex_corner[hex_edges[le][0]][axis] ? kUnit - n.param[axis] : n.param[axis];
-        if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t = kUnit - t;
-        id = node_at(make_key(TemplateNodeKey::edge, e, t), position, &aliased);
+      case TemplateNodeKey::edge:
+      case TemplateNodeKey::face:
+        id = node_at(plan_node_key(h, n, frame), position, &aliased);
         break;
-      }
-      case TemplateNodeKey::face: {
-        const int lf = n.local;
-        auto& fr = frame[lf];
-        if (fr[0] < 0) {
-          int i0 = 0;
-          for (int c = 1; c < 4; ++c)
-            if (input[hex_faces[lf][c]] < input[hex_faces[lf][i0]]) i0 = c;
-          const int step =
-              input[hex_faces[lf][(i0 + 1) % 4]] < input[hex_faces[lf][(i0 + 3) % 4]] ? 1 : 3;
-          fr = {static_cast<int8_t>(hex_faces[lf][i0]),
-                static_cast<int8_t>(hex_faces[lf][(i0 + step) % 4]),
-                static_cast<int8_t>(hex_faces[lf][(i0 + 3 * step) % 4])};
-        }
-        const int* o = hex_corner[fr[0]];
-        const int* c1 = hex_corner[fr[1]];
-        const int* c3 = hex_corner[fr[2]];
-        int64_t u = 0, v = 0;
-        for (int k = 0; k < 3; ++k) {
-          u += (c1[k] - o[k]) * (n.param[k] - o[k] * kUnit);
-          v += (c3[k] - o[k]) * (n.param[k] - o[k] * kUnit);
-        }
-        const int32_t f = topology_.hex_face_ids[h][lf];
-        id = node_at(make_key(TemplateNodeKey::face, f, u, v), position, &aliased);
-        break;
-      }
       default: {
         const TemplateNodeKey key = make_key(TemplateNodeKey::interior, h,
                                              n.param[0] * (kUnit + 1) + n.param[1], n.param[2]);
@@ -615,6 +586,141 @@ void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
     for (int k = 0; k < 8; ++k) out[k] = placed_ids_[c[k]];
     children.push_back(out);
   }
+}
+
+TemplateNodeKey TemplateRefiner::plan_node_key(int32_t h, const TemplatePlanNode& n,
+                                               std::array<std::array<int8_t, 3>, 6>& frame) const {
+  const HexCell& input = mesh_.hexes[h];
+  if (n.kind == TemplateNodeKey::edge) {
+    const int le = n.local;
+    const int32_t e = topology_.hex_edge_ids[h][le];
+    const int axis = hex_edge_axis[le];
+    int64_t t = hex_corner[hex_edges[le][0]][axis] ? kUnit - n.param[axis] : n.param[axis];
+    if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t = kUnit - t;
+    return make_key(TemplateNodeKey::edge, e, t);
+  }
+  // The canonical frame of the face (as key_at): origin at its lowest node id, u towards the
+  // lower-id neighbour; computed once per face and hex (frame[lf][0] < 0: not yet).
+  const int lf = n.local;
+  auto& fr = frame[lf];
+  if (fr[0] < 0) {
+    int i0 = 0;
+    for (int c = 1; c < 4; ++c)
+      if (input[hex_faces[lf][c]] < input[hex_faces[lf][i0]]) i0 = c;
+    const int step =
+        input[hex_faces[lf][(i0 + 1) % 4]] < input[hex_faces[lf][(i0 + 3) % 4]] ? 1 : 3;
+    fr = {static_cast<int8_t>(hex_faces[lf][i0]),
+          static_cast<int8_t>(hex_faces[lf][(i0 + step) % 4]),
+          static_cast<int8_t>(hex_faces[lf][(i0 + 3 * step) % 4])};
+  }
+  const int* o = hex_corner[fr[0]];
+  const int* c1 = hex_corner[fr[1]];
+  const int* c3 = hex_corner[fr[2]];
+  int64_t u = 0, v = 0;
+  for (int k = 0; k < 3; ++k) {
+    u += (c1[k] - o[k]) * (n.param[k] - o[k] * kUnit);
+    v += (c3[k] - o[k]) * (n.param[k] - o[k] * kUnit);
+  }
+  return make_key(TemplateNodeKey::face, topology_.hex_face_ids[h][lf], u, v);
+}
+
+void TemplateRefiner::apply_whole_batch(std::span<const TemplateApplication> apps,
+                                        std::span<const size_t> child_offset,
+                                        std::vector<HexCell>& children, int threads) {
+  bool parallel = threads > 1 && aliases_.empty() && apps.size() > 1;
+  for (const TemplateApplication& a : apps) {
+    if (!parallel) break;
+    const HexTemplate& t = *a.tmpl;
+    parallel = !t.plans.empty() && !t.plans[a.symmetry].generic && t.plans[a.symmetry].slotted;
+    const HexCell& c = mesh_.hexes[a.hex];
+    for (int i = 0; i < 8 && parallel; ++i)
+      for (int j = i + 1; j < 8; ++j) parallel = parallel && c[i] != c[j];
+  }
+  if (!parallel) {
+    std::vector<HexCell> out;
+    for (size_t i = 0; i < apps.size(); ++i) {
+      out.clear();
+      apply_whole(apps[i].hex, *apps[i].tmpl, apps[i].symmetry, true, out);
+      std::copy(out.begin(), out.end(),
+                children.begin() + static_cast<std::ptrdiff_t>(child_offset[i]));
+    }
+    return;
+  }
+  // 1. Claim node ids in order, exactly as the serial calls would create them.
+  const int32_t first_free = static_cast<int32_t>(points_.size());
+  std::vector<int32_t> first_new(apps.size() + 1);
+  int32_t next = first_free;
+  std::array<std::array<int8_t, 3>, 6> frame;
+  for (size_t i = 0; i < apps.size(); ++i) {
+    first_new[i] = next;
+    const TemplatePlan& plan = apps[i].tmpl->plans[apps[i].symmetry];
+    for (auto& f : frame) f[0] = -1;
+    for (const TemplatePlanNode& n : plan.nodes) {
+      if (n.kind == TemplateNodeKey::corner) continue;
+      if (n.kind == TemplateNodeKey::interior) {
+        ++next;
+        continue;
+      }
+      int32_t* s = slot_of(plan_node_key(apps[i].hex, n, frame));
+      if (*s < 0) *s = next++;
+    }
+  }
+  first_new[apps.size()] = next;
+  points_.resize(static_cast<size_t>(next));  // Eigen leaves them uninitialised: no page touched
+  if (record_keys_) created_keys_.resize(static_cast<size_t>(next) - mesh_.points.size());
+  // 2. Positions, keys and children, in contiguous runs of applications.
+  auto run = [&](size_t begin, size_t end) {
+    std::array<std::array<int8_t, 3>, 6> fr;
+    std::vector<int32_t> ids;
+    for (size_t i = begin; i < end; ++i) {
+      const int32_t h = apps[i].hex;
+      const HexCell& input = mesh_.hexes[h];
+      const TemplatePlan& plan = apps[i].tmpl->plans[apps[i].symmetry];
+      std::array<Eigen::Vector3d, 8> x;
+      for (int v = 0; v < 8; ++v) x[v] = mesh_.points[input[v]];
+      for (auto& f : fr) f[0] = -1;
+      ids.resize(plan.nodes.size());
+      int32_t own = first_new[i];
+      for (size_t j = 0; j < plan.nodes.size(); ++j) {
+        const TemplatePlanNode& n = plan.nodes[j];
+        TemplateNodeKey key;
+        int32_t id;
+        if (n.kind == TemplateNodeKey::corner) {
+          ids[j] = input[n.local];
+          continue;
+        }
+        if (n.kind == TemplateNodeKey::interior) {
+          key = make_key(TemplateNodeKey::interior, h, n.param[0] * (kUnit + 1) + n.param[1],
+                         n.param[2]);
+          id = own++;
+        } else {
+          key = plan_node_key(h, n, fr);
+          id = *slot_of(key);
+          if (id < first_new[i]) {
+            ids[j] = id;
+            continue;
+          }
+          ++own;
+        }
+        ids[j] = id;
+        Eigen::Vector3d p = Eigen::Vector3d::Zero();
+        for (int v = 0; v < 8; ++v) p += n.weight[v] * x[v];
+        points_[id] = p;
+        if (record_keys_) created_keys_[id - mesh_.points.size()] = key;
+      }
+      HexCell* out = children.data() + child_offset[i];
+      for (const auto& c : plan.children) {
+        for (int k = 0; k < 8; ++k) (*out)[k] = ids[c[k]];
+        ++out;
+      }
+    }
+  };
+  const size_t parts = std::min<size_t>(static_cast<size_t>(threads), apps.size());
+  std::vector<std::thread> workers;
+  for (size_t p = 1; p < parts; ++p)
+    workers.emplace_back(run, apps.size() * p / parts, apps.size() * (p + 1) / parts);
+  run(0, apps.size() / parts);
+  for (std::thread& w : workers) w.join();
 }
 
 void template_compile(HexTemplate& t) {
@@ -650,6 +756,14 @@ void template_compile(HexTemplate& t) {
         }
         n.weight[v] = w;
       }
+      // Slot grid: sixths 2, 3 and 4 (TemplateRefiner::slot_of), in every free coordinate.
+      bool slot_grid = true;
+      for (int k = 0; k < 3; ++k) {
+        const int64_t q = n.param[k];
+        if (q == 0 || q == kUnit) continue;
+        slot_grid =
+            slot_grid && q % (kUnit / 6) == 0 && q / (kUnit / 6) >= 2 && q / (kUnit / 6) <= 4;
+      }
       if (tn.adjustment_edge >= 0 || !on_grid) {
         plan.generic = true;
       } else if (extreme == 3) {
@@ -657,11 +771,13 @@ void template_compile(HexTemplate& t) {
         n.local = static_cast<int8_t>(
             vertex_of({int(n.param[0] / kUnit), int(n.param[1] / kUnit), int(n.param[2] / kUnit)}));
       } else if (extreme == 2) {
+        plan.slotted = plan.slotted && slot_grid;
         n.kind = TemplateNodeKey::edge;
         n.local = static_cast<int8_t>(local_edge_at(
             {double(n.param[0] / kUnit), double(n.param[1] / kUnit), double(n.param[2] / kUnit)},
             free_axis));
       } else if (extreme == 1) {
+        plan.slotted = plan.slotted && slot_grid;
         n.kind = TemplateNodeKey::face;
         n.local = static_cast<int8_t>(2 * fixed_axis + (n.param[fixed_axis] == kUnit ? 1 : 0));
       } else {
@@ -678,7 +794,7 @@ void template_compile(HexTemplate& t) {
 
 TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topology,
                                     std::span<const TemplateApplication> applications,
-                                    std::span<const TemplateFaceAlias> aliases) {
+                                    std::span<const TemplateFaceAlias> aliases, int threads) {
   const int32_t nh = mesh.hex_count();
   std::vector<int32_t> application_of(nh, -1);
   for (size_t i = 0; i < applications.size(); ++i) {
@@ -702,25 +818,33 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
     out_hexes += a.tmpl->children.size() - 1;
     new_nodes += a.tmpl->nodes.size();
   }
-  res.hexes.reserve(out_hexes);
-  out.parent.reserve(out_hexes);
   refiner.reserve_created(new_nodes);
+  res.hexes.resize(out_hexes);
+  out.parent.resize(out_hexes);
+  std::vector<size_t> offsets;
+  offsets.reserve(applications.size());
+  std::vector<TemplateApplication> ordered;
+  ordered.reserve(applications.size());
+  size_t at = 0;
   for (int32_t h = 0; h < nh; ++h) {
     const int32_t a = application_of[h];
+    const size_t before = at;
     if (a < 0) {
-      res.hexes.push_back(mesh.hexes[h]);
-      out.parent.push_back(h);
-      continue;
+      res.hexes[at++] = mesh.hexes[h];
+    } else {
+      ordered.push_back(applications[a]);
+      offsets.push_back(at);
+      at += applications[a].tmpl->children.size();
+      out.hexes_created += static_cast<int64_t>(applications[a].tmpl->children.size());
+      out.hexes_deleted += 1;
     }
-    const size_t before = res.hexes.size();
-    try {
-      refiner.apply_whole(h, *applications[a].tmpl, applications[a].symmetry, true, res.hexes);
-    } catch (const OperationError& e) {
-      throw OperationError(std::string("templates_apply: ") + e.what());
-    }
-    out.parent.resize(res.hexes.size(), h);
-    out.hexes_created += static_cast<int64_t>(res.hexes.size() - before);
-    out.hexes_deleted += 1;
+    std::fill(out.parent.begin() + static_cast<std::ptrdiff_t>(before),
+              out.parent.begin() + static_cast<std::ptrdiff_t>(at), h);
+  }
+  try {
+    refiner.apply_whole_batch(ordered, offsets, res.hexes, threads);
+  } catch (const OperationError& e) {
+    throw OperationError(std::string("templates_apply: ") + e.what());
   }
   res.points = std::move(refiner.points());
 

@@ -65,6 +65,9 @@ struct TemplatePlan {
   std::vector<TemplatePlanNode> nodes;
   std::vector<std::array<int16_t, 8>> children;
   bool generic = false;  ///< some node needs the generic path (TemplateRefiner::apply)
+  /// Every edge and face node lies on the slot grid (thirds and halves): the plan can be
+  /// applied in parallel (TemplateRefiner::apply_whole_batch).
+  bool slotted = true;
 };
 
 /// A template in canonical orientation. Children are 8 node indices each, VTK order, positively
@@ -251,6 +254,16 @@ class TemplateRefiner {
   const std::vector<Eigen::Vector3d>& points() const { return points_; }
   std::vector<Eigen::Vector3d>& points() { return points_; }
 
+  /// apply_whole on every application in order, interior nodes private, children written to
+  /// children[child_offset[i] + c] (children sized by the caller): the same node ids, positions,
+  /// keys and children as the serial calls, with the positions and children of up to `threads`
+  /// contiguous runs of applications written in parallel after the node ids have been claimed
+  /// in order. Serial when threads <= 1, when aliases exist or a plan is not slotted.
+  /// Preconditions: ascending distinct hexes, each given once.
+  void apply_whole_batch(std::span<const TemplateApplication> applications,
+                         std::span<const size_t> child_offset, std::vector<HexCell>& children,
+                         int threads);
+
   /// Reserves room for `nodes` created nodes (an estimate: saves reallocating the outputs).
   void reserve_created(size_t nodes);
 
@@ -287,6 +300,9 @@ class TemplateRefiner {
   };
   std::vector<Placed> placed_;       ///< scratch of apply()
   std::vector<int32_t> placed_ids_;  ///< scratch of apply_whole()
+  /// Key of a compiled edge or face node of a whole hex (kind edge or face only).
+  TemplateNodeKey plan_node_key(int32_t hex, const TemplatePlanNode& n,
+                                std::array<std::array<int8_t, 3>, 6>& frame) const;
 };
 
 /// Applies every template application to its hex at once and returns the new mesh: untouched
@@ -295,11 +311,12 @@ class TemplateRefiner {
 /// "template_tag" set from each template's tag (untouched hexes keep theirs, or 0); and
 /// "refinement_level" incremented for children.
 /// Preconditions: at most one application per hex; `topology` built from `mesh`.
-/// Throws OperationError if a template asks for more distinct nodes on one edge or face than
-/// a slot can hold (a template bug), naming the hex.
+/// `threads`: see RefineOptions::threads (the output does not depend on it).
+/// Throws OperationError if a cell is degenerate, naming the hex.
 TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topology,
                                     std::span<const TemplateApplication> applications,
-                                    std::span<const TemplateFaceAlias> aliases = {});
+                                    std::span<const TemplateFaceAlias> aliases = {},
+                                    int threads = 1);
 
 /// The standard templates in canonical orientation (see templates.cpp for each template's
 /// split-edge pattern and construction). Only the ones defined so far are listed.

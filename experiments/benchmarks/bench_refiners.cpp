@@ -184,6 +184,20 @@ RefineResult sheet_rounds(const HexMesh& mesh, const Targets& targets,
   return sheet_refine(mesh, targets, options, control);
 }
 
+// Both refiners with two threads for the template application (the same output).
+RefineResult selective_2_threads(const HexMesh& mesh, const Targets& targets,
+                                 const RefineOptions& options) {
+  RefineOptions o = options;
+  o.threads = 2;
+  return selective_refine(mesh, targets, o);
+}
+RefineResult sheet_2_threads(const HexMesh& mesh, const Targets& targets,
+                             const RefineOptions& options) {
+  RefineOptions o = options;
+  o.threads = 2;
+  return sheet_refine(mesh, targets, o);
+}
+
 void sizes(benchmark::internal::Benchmark* b) {
   bench_brick_sizes(b, 10, 10);
 }
@@ -191,6 +205,8 @@ void sizes(benchmark::internal::Benchmark* b) {
 BENCHMARK_CAPTURE(bench_full_brick, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, selective, selective)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, sheet_rounds, &sheet_rounds)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_full_brick, selective_2_threads, &selective_2_threads)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_full_brick, sheet_2_threads, &sheet_2_threads)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, sheet_one_per_pass, &sheet_one_per_pass)
     ->Apply([](benchmark::internal::Benchmark* b) {
       if (bench_smoke())

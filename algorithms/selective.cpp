@@ -962,35 +962,51 @@ PassOutput SelectivePass::run() {
   // through the batch (parallel with options.threads, the same output).
   std::vector<TemplateApplication> apps;
   std::vector<size_t> offsets;
-  res.hexes.resize(out_hexes);
-  out.parent.resize(out_hexes);
+  // One thread: children appended as they are made. More: slots laid out first, the batch
+  // fills the template hexes' slots in parallel.
+  const bool parallel = options_.threads > 1;
+  if (parallel)
+    res.hexes.resize(out_hexes);
+  else
+    res.hexes.reserve(out_hexes);
+  out.parent.reserve(out_hexes);
   size_t at = 0;
+  auto put = [&](const HexCell& c) {
+    if (parallel)
+      res.hexes[at] = c;
+    else
+      res.hexes.push_back(c);
+    ++at;
+  };
   for (int32_t h = 0; h < nh; ++h) {
     const size_t before = at;
     TemplateTag tag = TemplateTag::untouched;
     if (role_[h] == kTarget || role_[h] == kElement) {
       const TemplateChoice c =
           role_[h] == kTarget ? TemplateChoice{&template_1_27(), 0} : element_choice_[h];
-      apps.push_back({h, c.tmpl, c.symmetry});
-      offsets.push_back(at);
+      if (parallel) {
+        apps.push_back({h, c.tmpl, c.symmetry});
+        offsets.push_back(at);
+      } else {
+        refiner_->apply_whole(h, *c.tmpl, c.symmetry, true, res.hexes);
+      }
       at += c.tmpl->children.size();
       tag = c.tmpl->tag;
     } else if (role_[h] == kDirectional) {
       const auto& cells = cells_[directional_index_[h]];
       if (cells.size() > 1 || !cells[0].whole) {
-        for (const TemplateCell& c : cells) res.hexes[at++] = c.nodes;
+        for (const TemplateCell& c : cells) put(c.nodes);
         tag = TemplateTag::directional;
       }
     }
-    if (at == before) res.hexes[at++] = mesh_.hexes[h];
-    std::fill(out.parent.begin() + static_cast<std::ptrdiff_t>(before),
-              out.parent.begin() + static_cast<std::ptrdiff_t>(at), h);
+    if (at == before) put(mesh_.hexes[h]);
+    out.parent.resize(at, h);
     if (tag == TemplateTag::untouched) continue;
     parent_tag[h] = static_cast<int32_t>(tag);
     stats_.hexes_created += static_cast<int64_t>(at - before);
     stats_.hexes_deleted += 1;
   }
-  refiner_->apply_whole_batch(apps, offsets, res.hexes, options_.threads);
+  if (parallel) refiner_->apply_whole_batch(apps, offsets, res.hexes, options_.threads);
   res.points = std::move(refiner_->points());
   for (const HexAttribute& attr : mesh_.attributes) {
     HexAttribute copy{attr.name, std::vector<int32_t>(res.hexes.size())};

@@ -819,32 +819,48 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
     new_nodes += a.tmpl->nodes.size();
   }
   refiner.reserve_created(new_nodes);
-  res.hexes.resize(out_hexes);
-  out.parent.resize(out_hexes);
+  // One thread: children appended as they are made. More: slots laid out first, the batch
+  // fills the template hexes' slots in parallel.
+  const bool parallel = threads > 1;
+  if (parallel)
+    res.hexes.resize(out_hexes);
+  else
+    res.hexes.reserve(out_hexes);
+  out.parent.reserve(out_hexes);
   std::vector<size_t> offsets;
-  offsets.reserve(applications.size());
   std::vector<TemplateApplication> ordered;
-  ordered.reserve(applications.size());
   size_t at = 0;
   for (int32_t h = 0; h < nh; ++h) {
     const int32_t a = application_of[h];
-    const size_t before = at;
     if (a < 0) {
-      res.hexes[at++] = mesh.hexes[h];
+      if (parallel)
+        res.hexes[at] = mesh.hexes[h];
+      else
+        res.hexes.push_back(mesh.hexes[h]);
+      ++at;
     } else {
-      ordered.push_back(applications[a]);
-      offsets.push_back(at);
+      if (parallel) {
+        ordered.push_back(applications[a]);
+        offsets.push_back(at);
+      } else {
+        try {
+          refiner.apply_whole(h, *applications[a].tmpl, applications[a].symmetry, true, res.hexes);
+        } catch (const OperationError& e) {
+          throw OperationError(std::string("templates_apply: ") + e.what());
+        }
+      }
       at += applications[a].tmpl->children.size();
       out.hexes_created += static_cast<int64_t>(applications[a].tmpl->children.size());
       out.hexes_deleted += 1;
     }
-    std::fill(out.parent.begin() + static_cast<std::ptrdiff_t>(before),
-              out.parent.begin() + static_cast<std::ptrdiff_t>(at), h);
+    out.parent.resize(at, h);
   }
-  try {
-    refiner.apply_whole_batch(ordered, offsets, res.hexes, threads);
-  } catch (const OperationError& e) {
-    throw OperationError(std::string("templates_apply: ") + e.what());
+  if (parallel) {
+    try {
+      refiner.apply_whole_batch(ordered, offsets, res.hexes, threads);
+    } catch (const OperationError& e) {
+      throw OperationError(std::string("templates_apply: ") + e.what());
+    }
   }
   res.points = std::move(refiner.points());
 

@@ -6,6 +6,7 @@
 /// std::to_chars and that goes to the stream in large chunks.
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -35,7 +36,17 @@ class TextCursor {
  public:
   TextCursor(const std::string& path, std::string_view text, char comment = 0,
              const char* extra_separators = "")
-      : path_(path), text_(text), comment_(comment), extra_(extra_separators) {}
+      : path_(path), text_(text), comment_(comment) {
+    // Byte classes as tables: the tokenizer looks at every byte of the file.
+    for (const char c : {' ', '\t', '\r', '\f', '\v'}) blank_[static_cast<unsigned char>(c)] = true;
+    for (const char* e = extra_separators; *e != 0; ++e)
+      blank_[static_cast<unsigned char>(*e)] = true;
+    stop_ = blank_;
+    stop_['\n'] = true;
+    // comment == 0 means "no comment character": a NUL byte is then part of the token (which
+    // will not parse), never an empty token that would stall a caller's loop.
+    if (comment_ != 0) stop_[static_cast<unsigned char>(comment_)] = true;
+  }
 
   const std::string& path() const { return path_; }
   /// For a cursor over a slice of a file: the line number of the slice's first byte.
@@ -61,11 +72,7 @@ class TextCursor {
     skip_space();
     if (pos_ >= text_.size()) fail("unexpected end of file, expected " + std::string(what));
     const size_t start = pos_;
-    // comment_ == 0 means "no comment character": a NUL byte is then part of the token (which
-    // will not parse), never an empty token that would stall a caller's loop.
-    while (pos_ < text_.size() && !is_space(text_[pos_]) && !is_extra(text_[pos_]) &&
-           (comment_ == 0 || text_[pos_] != comment_))
-      ++pos_;
+    while (pos_ < text_.size() && !stop_[static_cast<unsigned char>(text_[pos_])]) ++pos_;
     return text_.substr(start, pos_ - start);
   }
 
@@ -193,16 +200,12 @@ class TextCursor {
   }
 
  private:
-  static bool is_space(char c) {
-    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
-  }
-  bool is_extra(char c) const { return c != 0 && std::strchr(extra_, c) != nullptr; }
   void skip_space() {
     while (pos_ < text_.size()) {
       const char c = text_[pos_];
       if (c == '\n') {
         ++line_, ++pos_;
-      } else if (is_space(c) || is_extra(c)) {
+      } else if (blank_[static_cast<unsigned char>(c)]) {
         ++pos_;
       } else if (comment_ != 0 && c == comment_) {
         while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
@@ -215,7 +218,8 @@ class TextCursor {
   std::string path_;
   std::string_view text_;
   char comment_;
-  const char* extra_;
+  std::array<bool, 256> blank_{};  ///< white space other than '\n', and the extra separators
+  std::array<bool, 256> stop_{};   ///< ends a token: blank_, '\n' and the comment character
   size_t pos_ = 0;
   int64_t line_ = 1;
 };

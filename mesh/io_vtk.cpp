@@ -608,6 +608,20 @@ HexMesh vtu_read(const std::string& path, const std::string& text) {
     std::string type;
   };
   std::vector<Pending> cell_arrays;
+  // Section openings and line numbers are followed forward from one array to the next, so the
+  // file is scanned once in all, not once per array.
+  constexpr std::string_view section_names[4] = {"<Points", "<Cells", "<CellData", "<PointData"};
+  int64_t section_at[4] = {-1, -1, -1, -1};  // last opening of each before `scanned`
+  size_t scanned = 0;
+  size_t line_pos = 0;  // line_no is the line of offset line_pos
+  int64_t line_no = 1;
+  auto line_at = [&](size_t pos) {
+    if (pos < line_pos) return line_of(all, pos);
+    line_no += std::count(all.begin() + static_cast<ptrdiff_t>(line_pos),
+                          all.begin() + static_cast<ptrdiff_t>(pos), '\n');
+    line_pos = pos;
+    return line_no;
+  };
   size_t p = piece_end;
   while ((p = all.find("<DataArray", p)) != std::string_view::npos) {
     const size_t tag_end = all.find('>', p);
@@ -619,13 +633,16 @@ HexMesh vtu_read(const std::string& path, const std::string& text) {
     const std::string format = xml_attribute(tag, "format");
     std::string type = xml_attribute(tag, "type");
     const std::string comps = xml_attribute(tag, "NumberOfComponents");
-    // Which section holds this array: the nearest section opening before it.
-    auto last = [&](std::string_view what) {
-      const size_t q = all.rfind(what, p);
-      return q == std::string_view::npos ? -1 : static_cast<int64_t>(q);
-    };
-    const int64_t in_points = last("<Points"), in_cells = last("<Cells"),
-                  in_cell_data = last("<CellData"), in_point_data = last("<PointData");
+    // Which section holds this array: the nearest section opening before it. (No opening can
+    // straddle p: the names hold '<' only first, and p is the '<' of "<DataArray".)
+    const std::string_view before = all.substr(0, p);
+    for (int k = 0; k < 4; ++k)
+      for (size_t q = scanned; (q = before.find(section_names[k], q)) != std::string_view::npos;
+           ++q)
+        section_at[k] = static_cast<int64_t>(q);
+    scanned = p;
+    const int64_t in_points = section_at[0], in_cells = section_at[1], in_cell_data = section_at[2],
+                  in_point_data = section_at[3];
     const int64_t section = std::max({in_points, in_cells, in_cell_data, in_point_data});
     if (format != "ascii")
       fail_at(p, "DataArray '" + name + "' has format \"" + format +
@@ -633,7 +650,7 @@ HexMesh vtu_read(const std::string& path, const std::string& text) {
     // The values end at the first nested element (VTK writes <InformationKey> after them).
     const size_t values_end = std::min(close, all.find('<', tag_end + 1));
     TextCursor in(path, all.substr(tag_end + 1, values_end - tag_end - 1));
-    in.set_line(line_of(all, tag_end + 1));
+    in.set_line(line_at(tag_end + 1));
     const std::string what = "values of DataArray '" + name + "'";
     static const std::pair<const char*, const char*> type_names[] = {
         {"Int8", "char"},     {"UInt8", "unsigned_char"},

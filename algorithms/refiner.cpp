@@ -1,6 +1,23 @@
 #include "algorithms/refiner.hpp"
 
+#include <array>
+
 namespace hexrefine {
+
+void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags) {
+  // One counter per tag value first: a string-keyed map lookup per hex would cost more than
+  // the refinement itself on large meshes.
+  std::array<int64_t, 10> known{};
+  for (int32_t t : tags) {
+    if (t >= 0 && t < static_cast<int32_t>(known.size()))
+      ++known[t];
+    else
+      ++stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(t))];
+  }
+  for (size_t t = 0; t < known.size(); ++t)
+    if (known[t])
+      stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(t))] += known[t];
+}
 
 const char* template_tag_name(TemplateTag tag) {
   switch (tag) {

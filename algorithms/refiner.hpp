@@ -30,6 +30,11 @@ enum class TemplateTag : int32_t {
 /// Short name used in reports ("1-27", "1-3-adj1", ...).
 const char* template_tag_name(TemplateTag tag);
 
+struct RefineStats;
+/// Fills stats.hexes_per_template from a list of per-hex template tags (values outside the
+/// enumeration are counted under template_tag_name's name for them).
+void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags);
+
 /// The hexes selected for refinement: ascending, unique ids into the input mesh.
 struct Targets {
   std::vector<int32_t> hexes;
@@ -42,6 +47,10 @@ struct RefineOptions {
   int passes = 1;           ///< Refine the region this many times.
   bool buffer = false;      ///< Add the previous pass's transition layer to the next targets.
   bool allow_inverted = false;
+  /// Threads for applying whole-hex templates (the assembly of the output). The output is
+  /// identical for every count: node ids are claimed in hex order first, then the positions
+  /// and children are written in parallel. 1: everything in the calling thread.
+  int threads = 1;
 };
 
 /// Statistics of one refinement. Fields a method does not use stay zero.

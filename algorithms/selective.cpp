@@ -73,6 +73,21 @@ bool hex_is_inverted(const HexMesh& m, int32_t h) {
   return hex_scaled_jacobian(hex_points(m, h)) <= 0.0;
 }
 
+// True if the hex is a parallelepiped (its trilinear map is affine) up to rounding: every corner
+// is x0 + the combination of the three edge vectors at corner 0 that its reference position
+// gives, within 1e-9 of the longest of those edges.
+bool hex_is_affine(const HexMesh& m, int32_t h) {
+  const auto x = hex_points(m, h);
+  const Eigen::Vector3d a = x[1] - x[0], b = x[3] - x[0], c = x[4] - x[0];
+  const double tol = 1e-9 * std::max({a.norm(), b.norm(), c.norm()});
+  for (int v = 0; v < 8; ++v) {
+    const Eigen::Vector3d expected =
+        x[0] + hex_corner[v][0] * a + hex_corner[v][1] * b + hex_corner[v][2] * c;
+    if ((x[v] - expected).norm() > tol) return false;
+  }
+  return true;
+}
+
 enum Role : uint8_t { kUntouched = 0, kTarget = 1, kElement = 2, kDirectional = 3 };
 
 // Local edges an element-by-element template or a directional step would adjust at, for a hex
@@ -244,9 +259,18 @@ class SelectivePass {
   void register_adjustments(const TemplateCell& cell, const TemplateChoice& c);
   void apply(const Decision& d, std::vector<TemplateCell>& next);
   void check_output(const PassOutput& out) const;
+  /// The topological part of check_output on the output hexes of the input hexes marked in
+  /// `in_region`; appends the input hexes of defects to `bad_parents`.
+  void check_region(const PassOutput& out, const std::vector<uint8_t>& in_region,
+                    std::vector<int32_t>& bad_parents) const;
   /// A hex with split mask `mask` is refined directionally: no template matches, or it was forced
   /// (its element-by-element children would invert).
   bool is_directional(int32_t h, uint16_t mask) const;
+  /// Directional, or refined by an adjusted template: conformity is checked around it.
+  bool hex_is_risky(int32_t h) const {
+    return role_[h] == kDirectional ||
+           (role_[h] == kElement && template_is_adjusted(element_choice_[h].tmpl));
+  }
 
   const HexMesh& mesh_;
   const std::vector<int32_t>& targets_;
@@ -734,65 +758,33 @@ void SelectivePass::check_output(const PassOutput& out) const {
   // most two hexes, every boundary face of the output lies on the input's boundary (a face left
   // open by non-matching subdivisions shows up as a boundary face inside the mesh), and no
   // output hex from a valid input hex is inverted (corner Jacobians).
-  const HexTopology t = topology_build(out.mesh);
-  std::vector<int32_t> bad_parents, inverted_parents;
-  for (int32_t f : t.nonmanifold_faces) bad_parents.push_back(out.parent[t.face_hexes[f][0]]);
-  const int32_t n_in = mesh_.point_count();
-  // A boundary face of the output must lie on one boundary face of the input: every node is
-  // an input node of that face, a node keyed on one of its edges, or a node keyed on it.
-  const auto& keys = refiner_->created_keys();
-  auto key_of = [&](int32_t n) -> const TemplateNodeKey* {
-    return n >= n_in ? &keys[n - n_in] : nullptr;
-  };
-  auto node_on_face = [&](int32_t n, int32_t f) {
-    const auto& fn = topo_.face_nodes[f];
-    auto has = [&](int32_t x) { return std::find(fn.begin(), fn.end(), x) != fn.end(); };
-    const TemplateNodeKey* k = key_of(n);
-    if (!k) return has(n);
-    const int32_t id = static_cast<int32_t>(k->entity & 0xFFFFFFFFFF);
-    if (k->kind() == TemplateNodeKey::face) return id == f;
-    if (k->kind() == TemplateNodeKey::edge)
-      return has(topo_.edge_nodes[id][0]) && has(topo_.edge_nodes[id][1]);
-    return false;
-  };
-  std::vector<int32_t> candidates;
-  for (int32_t f : topology_boundary_faces(t)) {
-    const auto& q = t.face_nodes[f];
-    candidates.clear();
-    int32_t anchor = q[0];
-    for (int32_t n : q) {
-      const TemplateNodeKey* k = key_of(n);
-      if (k && k->kind() == TemplateNodeKey::face) anchor = n;
+  // Where it looks: a face between two hexes refined by the basic templates (1-27, 1-13, 1-5,
+  // 1-4, 1-3) or left untouched is conformal by construction, because each basic template
+  // subdivides a face only as a function of that face's split edges (asserted for every
+  // template, symmetry and face by test_templates) and the nodes are keyed by the face. So the
+  // topological check covers the "risky" input hexes (directional ones and adjusted templates,
+  // whose adjustments alias their neighbours' face nodes) and the ring of their face
+  // neighbours; the rest of the output is never rebuilt. Children of an affine input hex are
+  // affine images of the template's children, which template_validate found positive, so only
+  // hexes from non-affine parents (or risky ones) get the inversion test.
+  const int32_t nh = mesh_.hex_count();
+  std::vector<uint8_t> in_region(nh, 0);
+  bool any_risky = false;
+  for (int32_t h = 0; h < nh; ++h) {
+    if (!hex_is_risky(h)) continue;
+    any_risky = true;
+    in_region[h] = 1;
+    for (int lf = 0; lf < 6; ++lf) {
+      const int32_t n = hex_face_neighbor(topo_, h, lf);
+      if (n >= 0) in_region[n] = 1;
     }
-    const TemplateNodeKey* k = key_of(anchor);
-    if (k && k->kind() == TemplateNodeKey::face) {
-      candidates.push_back(static_cast<int32_t>(k->entity & 0xFFFFFFFFFF));
-    } else {
-      // Boundary faces of the input hexes around an input node of this face, or around the
-      // edge a keyed node sits on.
-      int32_t around = -1;
-      for (int32_t n : q)
-        if (n < n_in) around = n;
-      if (around < 0 && k && k->kind() == TemplateNodeKey::edge)
-        around = topo_.edge_nodes[k->entity & 0xFFFFFFFFFF][0];
-      if (around >= 0)
-        for (int32_t h : node_hexes(topo_, around))
-          for (int32_t g : topo_.hex_face_ids[h])
-            if (face_is_boundary(topo_, g)) candidates.push_back(g);
-    }
-    bool ok = false;
-    for (int32_t g : candidates) {
-      bool all = face_is_boundary(topo_, g);
-      for (int32_t n : q) all = all && node_on_face(n, g);
-      if (all) {
-        ok = true;
-        break;
-      }
-    }
-    if (!ok) bad_parents.push_back(out.parent[t.face_hexes[f][0]]);
   }
+  std::vector<int32_t> bad_parents, inverted_parents;
+  if (any_risky) check_region(out, in_region, bad_parents);
+  std::vector<uint8_t> affine(nh, 0);
+  for (int32_t h = 0; h < nh; ++h) affine[h] = !in_region[h] && hex_is_affine(mesh_, h);
   for (int32_t h = 0; h < out.mesh.hex_count(); ++h) {
-    if (out.role[out.parent[h]] == kUntouched) continue;
+    if (out.role[out.parent[h]] == kUntouched || affine[out.parent[h]]) continue;
     if (options_.allow_inverted && hex_is_inverted(mesh_, out.parent[h])) continue;
     const auto x = hex_points(out.mesh, h);
     for (int v = 0; v < 8; ++v) {
@@ -832,6 +824,89 @@ void SelectivePass::check_output(const PassOutput& out) const {
         listed(inverted_parents));
 }
 
+void SelectivePass::check_region(const PassOutput& out, const std::vector<uint8_t>& in_region,
+                                 std::vector<int32_t>& bad_parents) const {
+  // The output hexes of the region, with compact node ids (global id of local node i:
+  // global_of[i]).
+  HexMesh sub;
+  std::vector<int32_t> sub_parent, global_of;
+  std::vector<int32_t> local_of(out.mesh.points.size(), -1);
+  for (int32_t h = 0; h < out.mesh.hex_count(); ++h) {
+    if (!in_region[out.parent[h]]) continue;
+    HexCell c = out.mesh.hexes[h];
+    for (int32_t& v : c) {
+      if (local_of[v] < 0) {
+        local_of[v] = static_cast<int32_t>(global_of.size());
+        global_of.push_back(v);
+      }
+      v = local_of[v];
+    }
+    sub.hexes.push_back(c);
+    sub_parent.push_back(out.parent[h]);
+  }
+  sub.points.resize(global_of.size(), Eigen::Vector3d::Zero());
+  const HexTopology t = topology_build(sub);
+  for (int32_t f : t.nonmanifold_faces) bad_parents.push_back(sub_parent[t.face_hexes[f][0]]);
+  const int32_t n_in = mesh_.point_count();
+  // A face of the region's surface must lie on one input face on the region's surface (an
+  // input boundary face, or a face to a hex outside the region): every node is an input node
+  // of that face, a node keyed on one of its edges, or a node keyed on it.
+  auto face_is_outer = [&](int32_t g) {
+    const auto& fh = topo_.face_hexes[g];
+    return fh[1] < 0 || !in_region[fh[0]] || !in_region[fh[1]];
+  };
+  const auto& keys = refiner_->created_keys();
+  auto key_of = [&](int32_t n) -> const TemplateNodeKey* {
+    return n >= n_in ? &keys[n - n_in] : nullptr;
+  };
+  auto node_on_face = [&](int32_t n, int32_t f) {
+    const auto& fn = topo_.face_nodes[f];
+    auto has = [&](int32_t x) { return std::find(fn.begin(), fn.end(), x) != fn.end(); };
+    const TemplateNodeKey* k = key_of(n);
+    if (!k) return has(n);
+    const int32_t id = static_cast<int32_t>(k->entity & 0xFFFFFFFFFF);
+    if (k->kind() == TemplateNodeKey::face) return id == f;
+    if (k->kind() == TemplateNodeKey::edge)
+      return has(topo_.edge_nodes[id][0]) && has(topo_.edge_nodes[id][1]);
+    return false;
+  };
+  std::vector<int32_t> candidates;
+  for (int32_t f : topology_boundary_faces(t)) {
+    std::array<int32_t, 4> q = t.face_nodes[f];
+    for (int32_t& n : q) n = global_of[n];
+    candidates.clear();
+    int32_t anchor = q[0];
+    for (int32_t n : q) {
+      const TemplateNodeKey* k = key_of(n);
+      if (k && k->kind() == TemplateNodeKey::face) anchor = n;
+    }
+    const TemplateNodeKey* k = key_of(anchor);
+    if (k && k->kind() == TemplateNodeKey::face) {
+      candidates.push_back(static_cast<int32_t>(k->entity & 0xFFFFFFFFFF));
+    } else {
+      // Input faces around an input node of this face, or around the edge a keyed node sits on.
+      int32_t around = -1;
+      for (int32_t n : q)
+        if (n < n_in) around = n;
+      if (around < 0 && k && k->kind() == TemplateNodeKey::edge)
+        around = topo_.edge_nodes[k->entity & 0xFFFFFFFFFF][0];
+      if (around >= 0)
+        for (int32_t h : node_hexes(topo_, around))
+          for (int32_t g : topo_.hex_face_ids[h]) candidates.push_back(g);
+    }
+    bool ok = false;
+    for (int32_t g : candidates) {
+      bool all = face_is_outer(g);
+      for (int32_t n : q) all = all && node_on_face(n, g);
+      if (all) {
+        ok = true;
+        break;
+      }
+    }
+    if (!ok) bad_parents.push_back(sub_parent[t.face_hexes[f][0]]);
+  }
+}
+
 PassOutput SelectivePass::run() {
   auto t0 = Clock::now();
   topo_ = topology_build(mesh_);
@@ -863,41 +938,76 @@ PassOutput SelectivePass::run() {
   PassOutput out;
   out.role = role_;
   HexMesh& res = out.mesh;
-  std::vector<TemplateCell> children;
-  std::vector<int32_t> tags;
+  std::vector<int32_t> parent_tag(mesh_.hex_count(), -1);  // tag of a refined input hex
   const int32_t nh = mesh_.hex_count();
+  size_t out_hexes = 0, new_nodes = 0;
   for (int32_t h = 0; h < nh; ++h) {
-    children.clear();
+    const HexTemplate* t = role_[h] == kTarget    ? &template_1_27()
+                           : role_[h] == kElement ? element_choice_[h].tmpl
+                                                  : nullptr;
+    out_hexes += t                          ? t->children.size()
+                 : role_[h] == kDirectional ? cells_[directional_index_[h]].size()
+                                            : 1;
+    if (t) new_nodes += t->nodes.size();
+  }
+  res.hexes.reserve(out_hexes);
+  out.parent.reserve(out_hexes);
+  // Node keys are needed only by the self-check around risky hexes (check_region).
+  bool any_risky = false;
+  for (int32_t h = 0; h < nh; ++h) any_risky = any_risky || hex_is_risky(h);
+  if (!any_risky) refiner_->set_record_keys(false);
+  refiner_->reserve_created(new_nodes);
+  // Untouched hexes and directional cells are copied; targets and element-by-element hexes get
+  // one whole-hex application each (their interior nodes are private to them), in hex order,
+  // through the batch (parallel with options.threads, the same output).
+  std::vector<TemplateApplication> apps;
+  std::vector<size_t> offsets;
+  // One thread: children appended as they are made. More: slots laid out first, the batch
+  // fills the template hexes' slots in parallel.
+  const bool parallel = options_.threads > 1;
+  if (parallel)
+    res.hexes.resize(out_hexes);
+  else
+    res.hexes.reserve(out_hexes);
+  out.parent.reserve(out_hexes);
+  size_t at = 0;
+  auto put = [&](const HexCell& c) {
+    if (parallel)
+      res.hexes[at] = c;
+    else
+      res.hexes.push_back(c);
+    ++at;
+  };
+  for (int32_t h = 0; h < nh; ++h) {
+    const size_t before = at;
     TemplateTag tag = TemplateTag::untouched;
-    if (role_[h] == kTarget) {
-      refiner_->apply(refiner_->cell_whole(h), template_1_27(), 0, children);
-      tag = TemplateTag::t1_27;
-    } else if (role_[h] == kElement) {
-      refiner_->apply(refiner_->cell_whole(h), *element_choice_[h].tmpl,
-                      element_choice_[h].symmetry, children);
-      tag = element_choice_[h].tmpl->tag;
+    if (role_[h] == kTarget || role_[h] == kElement) {
+      const TemplateChoice c =
+          role_[h] == kTarget ? TemplateChoice{&template_1_27(), 0} : element_choice_[h];
+      if (parallel) {
+        apps.push_back({h, c.tmpl, c.symmetry});
+        offsets.push_back(at);
+      } else {
+        refiner_->apply_whole(h, *c.tmpl, c.symmetry, true, res.hexes);
+      }
+      at += c.tmpl->children.size();
+      tag = c.tmpl->tag;
     } else if (role_[h] == kDirectional) {
       const auto& cells = cells_[directional_index_[h]];
       if (cells.size() > 1 || !cells[0].whole) {
-        children = cells;
+        for (const TemplateCell& c : cells) put(c.nodes);
         tag = TemplateTag::directional;
       }
     }
-    if (children.empty()) {
-      res.hexes.push_back(mesh_.hexes[h]);
-      out.parent.push_back(h);
-      tags.push_back(-1);
-      continue;
-    }
-    for (const TemplateCell& c : children) {
-      res.hexes.push_back(c.nodes);
-      out.parent.push_back(h);
-      tags.push_back(static_cast<int32_t>(tag));
-    }
-    stats_.hexes_created += static_cast<int64_t>(children.size());
+    if (at == before) put(mesh_.hexes[h]);
+    out.parent.resize(at, h);
+    if (tag == TemplateTag::untouched) continue;
+    parent_tag[h] = static_cast<int32_t>(tag);
+    stats_.hexes_created += static_cast<int64_t>(at - before);
     stats_.hexes_deleted += 1;
   }
-  res.points = refiner_->points();
+  if (parallel) refiner_->apply_whole_batch(apps, offsets, res.hexes, options_.threads);
+  res.points = std::move(refiner_->points());
   for (const HexAttribute& attr : mesh_.attributes) {
     HexAttribute copy{attr.name, std::vector<int32_t>(res.hexes.size())};
     for (size_t i = 0; i < res.hexes.size(); ++i) copy.values[i] = attr.values[out.parent[i]];
@@ -906,10 +1016,10 @@ PassOutput SelectivePass::run() {
   const std::vector<int32_t>* in_level = mesh_find_attribute(mesh_, attribute_refinement_level);
   std::vector<int32_t> level(res.hexes.size());
   for (size_t i = 0; i < res.hexes.size(); ++i)
-    level[i] = (in_level ? (*in_level)[out.parent[i]] : 0) + (tags[i] >= 0 ? 1 : 0);
+    level[i] = (in_level ? (*in_level)[out.parent[i]] : 0) + (parent_tag[out.parent[i]] >= 0);
   std::vector<int32_t>& tag_attr = mesh_attribute(res, attribute_template_tag, 0);
   for (size_t i = 0; i < res.hexes.size(); ++i)
-    if (tags[i] >= 0) tag_attr[i] = tags[i];
+    if (parent_tag[out.parent[i]] >= 0) tag_attr[i] = parent_tag[out.parent[i]];
   mesh_attribute(res, attribute_refinement_level, 0) = std::move(level);
   stats_.phase_seconds["assembly"] += seconds_since(t4);
 
@@ -942,7 +1052,10 @@ RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
                        " inverted hexes, first at id " + std::to_string(first));
   }
   std::vector<int32_t> current_targets = targets.hexes;
-  HexMesh current = mesh;
+  // The mesh a pass refines: the input for the first pass (not copied), the previous pass's
+  // output after that.
+  HexMesh current;
+  const HexMesh* source = &mesh;
   for (int pass = 0; pass < options.passes; ++pass) {
     // A pass that meets an adjustment it can only avoid by splitting an input edge starts
     // again with that edge split (each attempt splits one more edge, so this ends).
@@ -952,13 +1065,13 @@ RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
     const RefineStats before = stats;
     for (;;) {
       try {
-        SelectivePass p(current, current_targets, options, stats, forced, forced_directional);
+        SelectivePass p(*source, current_targets, options, stats, forced, forced_directional);
         out = p.run();
         break;
       } catch (const DirectionalFallbackNeeded& need) {
         // Distorted hexes whose element-by-element children would invert: refine them
         // directionally instead (each attempt forces at least one more hex, so this ends).
-        if (forced_directional.empty()) forced_directional.assign(current.hex_count(), 0);
+        if (forced_directional.empty()) forced_directional.assign(source->hex_count(), 0);
         bool progress = false;
         for (int32_t h : need.hexes) {
           progress = progress || !forced_directional[h];
@@ -989,14 +1102,13 @@ RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
       }
     }
     current = std::move(out.mesh);
+    source = &current;
     current_targets = std::move(next);
   }
   result.mesh = std::move(current);
   stats.final_hexes = result.mesh.hex_count();
   stats.final_nodes = result.mesh.point_count();
-  const auto* tag = mesh_find_attribute(result.mesh, attribute_template_tag);
-  for (int32_t h = 0; h < result.mesh.hex_count(); ++h)
-    ++stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(tag ? (*tag)[h] : 0))];
+  stats_count_templates(stats, mesh_attribute(result.mesh, attribute_template_tag, 0));
   stats.time_seconds = seconds_since(t0);
   stats.phase_seconds["total"] = stats.time_seconds;
   return result;

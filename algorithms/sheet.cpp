@@ -30,14 +30,22 @@
 //     is one round, and processing the pieces of one round together is the same as processing
 //     them one after the other, since they share no hex (sheet_passes counts the pieces). For a
 //     structured brick the rounds are the x-, y- and z-like sheets.
-//  4. Rounds. The refined region (the hexes with a split edge) is copied with compact node ids
-//     and refined round by round with the directional templates (templates_apply). Every output
-//     hex carries, per local axis, the sheet piece it still has to be refined in; a child's axis
-//     inherits the piece of the parent axis its split edges run along (computed from the
-//     template data once per template orientation), the axis just refined is done. New nodes
-//     inside a split edge are marked (so the strips of a 1-3 face are split in the next
-//     direction); new face and interior nodes are not. A fully refined hex goes
-//     1 -> 3 -> 9 -> 27 (13 deleted, 39 created, thesis 4.3).
+//  4. Rounds. The refined region (the hexes with a split edge) is refined round by round with
+//     the directional templates. Every hex carries, per local axis, the sheet piece it still
+//     has to be refined in; a child's axis inherits the piece of the parent axis its split
+//     edges run along (computed from the template data once per template orientation), the
+//     axis just refined is done. New nodes inside a split edge are marked (so the strips of a
+//     1-3 face are split in the next direction); new face and interior nodes are not. A fully
+//     refined hex goes 1 -> 3 -> 9 -> 27 (13 deleted, 39 created, thesis 4.3).
+//     Two ways to run them, with the same mesh: (a) composites (default): what the rounds do to
+//     one hex depends only on its corner marks and the order of its axes' pieces, so the rounds
+//     of each configuration met are run once on a one-hex region (the reference cube) and the
+//     result is applied to all hexes of that configuration as one template (templates_apply,
+//     nodes keyed on the input's edges and faces); neighbours' shared faces are compared on
+//     their final subdivisions before anything is applied. (b) round by round on the whole
+//     region (an observer, one sheet per pass, or SheetControl::composites = false): the region
+//     is copied with compact node ids and every round builds the next mesh (templates_apply
+//     over that mesh's topology), as Harris' implementation did.
 //  5. Assembly: the untouched hexes and the refined region in input hex order. Every refined
 //     hex is tagged TemplateTag::sheet, its refinement level one above its input hex's.
 // Options: `passes` repeats the whole on the descendants of the given targets; the selective
@@ -45,8 +53,10 @@
 // A safety check before every round makes sure all hexes around each split edge split it in
 // that round (OperationError otherwise), so a result is conformal by construction.
 //
-// Speed: every step is linear in the size of the refined region (plus one copy of the mesh and
-// one pass over its edges for the dual sheet labels); there is no rescan of the mesh per sheet.
+// Speed: every step is linear in the size of the refined region (plus one pass over the mesh's
+// edges for the dual sheet labels); there is no rescan of the mesh per sheet. With composites
+// the output is written once, as by the selective refiner; round by round, every intermediate
+// mesh and its topology are built (the thesis' intrinsic 39 created + 13 deleted per hex).
 
 #include "algorithms/sheet.hpp"
 
@@ -54,6 +64,8 @@
 #include <array>
 #include <bit>
 #include <chrono>
+#include <functional>
+#include <memory>
 #include <numeric>
 #include <string>
 
@@ -368,6 +380,342 @@ std::string hex_list(const std::vector<int32_t>& hexes) {
   return s;
 }
 
+// Hexes created and deleted by the rounds.
+struct RoundCounts {
+  int64_t created = 0, deleted = 0;
+};
+
+// Refines `region` round by round: in round r, every hex refines the local axes whose piece has
+// colour r, with the directional template its split edges (node marks) call for; children
+// inherit the pieces of the parent axes their edges run along, new nodes inside split edges
+// are marked. `piece_name` describes a piece for messages; `after_round`, if set, is called
+// after every round. Throws OperationError where a hex has no directional template or two
+// hexes around a split edge would not split it in the same round.
+RoundCounts region_run_rounds(Region& region, const std::vector<int32_t>& color,
+                              int32_t round_count,
+                              const std::function<std::string(int32_t)>& piece_name,
+                              const std::function<void(int32_t)>& after_round) {
+  RoundCounts counts;
+  const DirectionalTable& table = directional_table();
+  for (int32_t round = 0; round < round_count; ++round) {
+    const HexMesh& cur = region.mesh;
+    const int32_t count = cur.hex_count();
+    const HexTopology rt = topology_build(cur);
+    std::vector<TemplateApplication> apps;
+    std::vector<int16_t> orientation_of(count, -1);
+    std::vector<uint8_t> axes_of(count, 0);  // axes refined in this round
+    for (int32_t h = 0; h < count; ++h) {
+      auto& occ = region.occurrence[h];
+      uint8_t axes = 0;
+      int32_t piece = -1;
+      for (int k = 0; k < 3; ++k) {
+        if (occ[k] < 0 || color[occ[k]] != round) continue;
+        // Two pieces of one colour never share a hex; one piece twice is a self-intersection.
+        if (piece >= 0 && occ[k] != piece)
+          throw OperationError("sheet refinement: a hex descending from input hex " +
+                               std::to_string(region.origin[h]) +
+                               " would be refined in two directions in one round (sheets of "
+                               "edges " +
+                               piece_name(piece) + " and " + piece_name(occ[k]) + ")");
+        piece = occ[k];
+        axes |= static_cast<uint8_t>(1u << k);
+      }
+      if (!axes) continue;
+      uint16_t wanted = 0;
+      for (int k = 0; k < 3; ++k)
+        if (axes & (1u << k)) {
+          wanted |= axis_mask(k);
+          occ[k] = -1;
+        }
+      const uint16_t split = hex_split_mask(cur, region.node_marked, h) & wanted;
+      if (!split) continue;
+      const int16_t o = table.by_mask[split];
+      if (o < 0)
+        throw OperationError("sheet refinement: a hex descending from input hex " +
+                             std::to_string(region.origin[h]) +
+                             " has a split pattern with no directional template (" +
+                             std::to_string(std::popcount(split)) + " edges split in " +
+                             std::to_string(std::popcount(axes)) +
+                             " directions) in the sheet of edge " + piece_name(piece));
+      orientation_of[h] = o;
+      axes_of[h] = table.orientations[o].axes;
+      apps.push_back({h, table.orientations[o].tmpl, table.orientations[o].symmetry});
+    }
+    // Conformity by construction needs every hex around a split edge to split it in this round.
+    for (const TemplateApplication& a : apps) {
+      const uint16_t split = hex_split_mask(cur, region.node_marked, a.hex);
+      for (int e = 0; e < 12; ++e) {
+        if (!(split & (1u << e)) || !(axes_of[a.hex] & (1u << hex_edge_axis[e]))) continue;
+        const int32_t id = rt.hex_edge_ids[a.hex][e];
+        for (int32_t g : edge_hexes(rt, id)) {
+          const int le = hex_local_edge(rt, g, id);
+          if (!(axes_of[g] & (1u << hex_edge_axis[le])))
+            throw OperationError("sheet refinement: hexes descending from input hexes " +
+                                 std::to_string(region.origin[a.hex]) + " and " +
+                                 std::to_string(region.origin[g]) +
+                                 " do not split their shared edge in the same sheet pass");
+        }
+      }
+    }
+
+    TemplateApplyResult applied = templates_apply(cur, rt, apps);
+    counts.created += applied.hexes_created;
+    counts.deleted += applied.hexes_deleted;
+
+    // The next state: occurrences inherited through the children's axes, edge nodes marked.
+    const int32_t out_count = applied.mesh.hex_count();
+    std::vector<std::array<int32_t, 3>> occurrence(out_count);
+    std::vector<int32_t> origin(out_count);
+    std::vector<uint8_t> marked = std::move(region.node_marked);
+    marked.resize(applied.mesh.points.size(), 0);
+    int32_t previous_parent = -1, child = 0;
+    for (int32_t i = 0; i < out_count; ++i) {
+      const int32_t parent = applied.parent[i];
+      child = parent == previous_parent ? child + 1 : 0;
+      previous_parent = parent;
+      origin[i] = region.origin[parent];
+      const int16_t o = orientation_of[parent];
+      if (o < 0) {
+        occurrence[i] = region.occurrence[parent];
+        continue;
+      }
+      const Orientation& orient = table.orientations[o];
+      for (int k = 0; k < 3; ++k) {
+        // The parent's refined axes were set to -1 above: children are done in them.
+        const int p = orient.child_axis[child][k];
+        occurrence[i][k] = p < 0 ? -1 : region.occurrence[parent][p];
+      }
+      const uint8_t edge_nodes = orient.child_edge_nodes[child];
+      for (int j = 0; j < 8; ++j)
+        if (edge_nodes & (1u << j)) marked[applied.mesh.hexes[i][j]] = 1;
+    }
+    region.mesh = std::move(applied.mesh);
+    region.mesh.attributes.clear();
+    region.occurrence = std::move(occurrence);
+    region.origin = std::move(origin);
+    region.node_marked = std::move(marked);
+    if (after_round) after_round(round);
+  }
+
+  return counts;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Composite templates: the rounds of one hex, replayed on the reference cube.
+//
+// What the rounds do to a hex depends only on its corner marks and on the order in which its
+// axes' pieces are refined (two axes of one piece: the same round). Inside the hex, every node
+// a round creates is marked or not by the same rule whoever creates it, so the cells' split
+// patterns are a function of that configuration. The rounds of each configuration met are run
+// once on a one-hex region (the unit cube) and the resulting cells become one template
+// (TemplateTag::sheet), applied to every hex of that configuration by templates_apply with the
+// nodes keyed on the input's edges and faces. Neighbours must subdivide their shared face alike;
+// the round-by-round path checks this per split edge and round, here it is checked on the final
+// face subdivisions (SheetComposite::face_hash), before anything is applied.
+
+struct SheetComposite {
+  HexTemplate tmpl;
+  RoundCounts counts;
+  bool positive = true;  // every child positive in the reference cube
+  // Hash of the subdivision of local face lf, in the face frame with origin at position i0 of
+  // hex_faces[lf] and u towards position i0 + step (index 2 * i0 + (step == 1 ? 0 : 1)).
+  std::array<std::array<uint64_t, 8>, 6> face_hash{};
+};
+
+uint64_t hash_mix(uint64_t h, int64_t x) {
+  h ^= static_cast<uint64_t>(x) + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
+  return h;
+}
+
+// Hashes of the face subdivisions of a template with exact parameters (see SheetComposite).
+void composite_face_hashes(SheetComposite& c) {
+  constexpr int64_t unit = template_param_unit;
+  std::vector<std::array<int64_t, 3>> param;
+  for (const TemplateNode& n : c.tmpl.nodes)
+    param.push_back({std::llround(n.ref[0] * unit), std::llround(n.ref[1] * unit),
+                     std::llround(n.ref[2] * unit)});
+  for (int lf = 0; lf < 6; ++lf) {
+    const int axis = lf / 2;
+    const int64_t level = (lf % 2) * unit;
+    for (int i0 = 0; i0 < 4; ++i0)
+      for (int step : {1, 3}) {
+        const int* o = hex_corner[hex_faces[lf][i0]];
+        const int* c1 = hex_corner[hex_faces[lf][(i0 + step) % 4]];
+        const int* c3 = hex_corner[hex_faces[lf][(i0 + 3 * step) % 4]];
+        std::vector<std::array<std::array<int64_t, 2>, 4>> quads;
+        for (const auto& child : c.tmpl.children)
+          for (int cf = 0; cf < 6; ++cf) {
+            std::array<std::array<int64_t, 2>, 4> q;
+            bool on = true;
+            for (int i = 0; i < 4; ++i) {
+              const auto& p = param[child[hex_faces[cf][i]]];
+              on = on && p[axis] == level;
+              int64_t u = 0, v = 0;
+              for (int k = 0; k < 3; ++k) {
+                u += (c1[k] - o[k]) * (p[k] - o[k] * unit);
+                v += (c3[k] - o[k]) * (p[k] - o[k] * unit);
+              }
+              q[i] = {u, v};
+            }
+            if (!on) continue;
+            std::sort(q.begin(), q.end());
+            quads.push_back(q);
+          }
+        std::sort(quads.begin(), quads.end());
+        uint64_t h = 0xCBF29CE484222325ull;
+        for (const auto& q : quads)
+          for (const auto& p : q) h = hash_mix(hash_mix(h, p[0]), p[1]);
+        c.face_hash[lf][2 * i0 + (step == 1 ? 0 : 1)] = h;
+      }
+  }
+}
+
+// The composite of a hex with corner marks `marks` (bit v: vertex v) whose local axis k is
+// refined in round rank[k] (-1: never).
+std::unique_ptr<SheetComposite> composite_build(uint8_t marks, const std::array<int8_t, 3>& rank,
+                                                int32_t input_hex) {
+  Region region;
+  for (int v = 0; v < 8; ++v) {
+    region.mesh.points.emplace_back(hex_corner[v][0], hex_corner[v][1], hex_corner[v][2]);
+    region.node_input.push_back(v);
+    region.node_marked.push_back((marks >> v) & 1);
+  }
+  region.mesh.hexes.push_back({0, 1, 2, 3, 4, 5, 6, 7});
+  region.input_nodes = 8;
+  region.origin = {input_hex};
+  region.occurrence = {{rank[0], rank[1], rank[2]}};
+  std::vector<int32_t> color = {0, 1, 2};
+  const int32_t rounds = 1 + std::max({rank[0], rank[1], rank[2]});
+  auto c = std::make_unique<SheetComposite>();
+  c->counts = region_run_rounds(region, color, rounds,
+                                [&](int32_t piece) {
+                                  std::string axes;
+                                  for (int k = 0; k < 3; ++k)
+                                    if (rank[k] == piece) axes += "xyz"[k];
+                                  return "through local axes " + axes + " of input hex " +
+                                         std::to_string(input_hex);
+                                },
+                                {});
+  c->tmpl.tag = TemplateTag::sheet;
+  for (const Eigen::Vector3d& x : region.mesh.points) c->tmpl.nodes.push_back({{x[0], x[1], x[2]}});
+  for (const HexCell& h : region.mesh.hexes) {
+    std::array<int16_t, 8> child{};
+    for (int k = 0; k < 8; ++k) child[k] = static_cast<int16_t>(h[k]);
+    c->tmpl.children.push_back(child);
+  }
+  for (int32_t h = 0; h < region.mesh.hex_count(); ++h)
+    c->positive = c->positive && hex_corners_positive(region.mesh, h);
+  template_compile(c->tmpl);
+  composite_face_hashes(*c);
+  return c;
+}
+
+// The face frame index (see SheetComposite::face_hash) of local face lf of hex h.
+int face_frame_index(const HexCell& hex, int lf) {
+  int i0 = 0;
+  for (int c = 1; c < 4; ++c)
+    if (hex[hex_faces[lf][c]] < hex[hex_faces[lf][i0]]) i0 = c;
+  const bool step1 = hex[hex_faces[lf][(i0 + 1) % 4]] < hex[hex_faces[lf][(i0 + 3) % 4]];
+  return 2 * i0 + (step1 ? 0 : 1);
+}
+
+// True if the hex is a parallelepiped up to rounding (its children are then affine images of
+// the composite's, whose orientation was checked once on the reference cube).
+bool hex_is_parallelepiped(const HexMesh& m, int32_t h) {
+  const auto x = hex_points(m, h);
+  const Eigen::Vector3d a = x[1] - x[0], b = x[3] - x[0], c = x[4] - x[0];
+  const double tol = 1e-9 * std::max({a.norm(), b.norm(), c.norm()});
+  for (int v = 0; v < 8; ++v)
+    if ((x[v] - (x[0] + hex_corner[v][0] * a + hex_corner[v][1] * b + hex_corner[v][2] * c))
+            .norm() > tol)
+      return false;
+  return true;
+}
+
+PassOutput refine_composites(const HexMesh& mesh, const HexTopology& topology,
+                             const RefineOptions& options, const std::vector<uint8_t>& node_marked,
+                             const std::vector<int32_t>& region_hexes,
+                             const std::vector<std::array<int32_t, 3>>& occurrence,
+                             const std::vector<int32_t>& color, RefineStats& stats) {
+  // Configuration: 8 mark bits, then per axis 2 bits of (rank + 1).
+  std::vector<std::unique_ptr<SheetComposite>> composites(1u << 14);
+  std::vector<const SheetComposite*> composite_of(region_hexes.size());
+  std::vector<TemplateApplication> apps;
+  apps.reserve(region_hexes.size());
+  for (size_t i = 0; i < region_hexes.size(); ++i) {
+    const int32_t h = region_hexes[i];
+    uint8_t marks = 0;
+    for (int v = 0; v < 8; ++v) marks |= static_cast<uint8_t>(node_marked[mesh.hexes[h][v]] << v);
+    std::array<int32_t, 3> c{};
+    for (int k = 0; k < 3; ++k) c[k] = occurrence[i][k] < 0 ? -1 : color[occurrence[i][k]];
+    std::array<int8_t, 3> rank{};
+    for (int k = 0; k < 3; ++k) {
+      rank[k] = -1;
+      if (c[k] < 0) continue;
+      int r = 0;  // dense rank among the hex's distinct colours
+      for (int m = 0; m < 3; ++m) {
+        bool counted = false;
+        for (int q = 0; q < m; ++q) counted = counted || c[q] == c[m];
+        r += !counted && c[m] >= 0 && c[m] < c[k];
+      }
+      rank[k] = static_cast<int8_t>(r);
+    }
+    const uint32_t key = marks | (rank[0] + 1) << 8 | (rank[1] + 1) << 10 | (rank[2] + 1) << 12;
+    if (!composites[key]) composites[key] = composite_build(marks, rank, h);
+    composite_of[i] = composites[key].get();
+    apps.push_back({h, &composite_of[i]->tmpl, 0});
+    stats.hexes_created += composite_of[i]->counts.created;
+    stats.hexes_deleted += composite_of[i]->counts.deleted;
+  }
+  // Shared faces subdivided alike (an unrefined neighbour's face is whole).
+  SheetComposite whole;
+  for (int v = 0; v < 8; ++v)
+    whole.tmpl.nodes.push_back(
+        {{double(hex_corner[v][0]), double(hex_corner[v][1]), double(hex_corner[v][2])}});
+  whole.tmpl.children.push_back({0, 1, 2, 3, 4, 5, 6, 7});
+  composite_face_hashes(whole);
+  const uint64_t whole_face = whole.face_hash[0][0];
+  std::vector<uint8_t> in_region(mesh.hexes.size(), 0);
+  for (int32_t h : region_hexes) in_region[h] = 1;
+  std::vector<uint64_t> face_seen(topology.face_count(), 0);
+  for (size_t i = 0; i < region_hexes.size(); ++i) {
+    const int32_t h = region_hexes[i];
+    for (int lf = 0; lf < 6; ++lf) {
+      const int32_t f = topology.hex_face_ids[h][lf];
+      if (face_is_boundary(topology, f)) continue;
+      const uint64_t hash = composite_of[i]->face_hash[lf][face_frame_index(mesh.hexes[h], lf)];
+      const int32_t n = hex_face_neighbor(topology, h, lf);
+      const uint64_t other = in_region[n] ? face_seen[f] : whole_face;
+      if (in_region[n] && other == 0) {
+        face_seen[f] = hash;
+        continue;
+      }
+      if (other != hash)
+        throw OperationError("sheet refinement: input hexes " + std::to_string(h) + " and " +
+                             std::to_string(n) +
+                             " would subdivide their shared face differently (their sheets "
+                             "split its edges in different passes)");
+    }
+  }
+  TemplateApplyResult applied = templates_apply(mesh, topology, apps, {}, options.threads);
+  if (!options.allow_inverted) {
+    std::vector<uint8_t> check(mesh.hexes.size(), 0);
+    for (size_t i = 0; i < region_hexes.size(); ++i) {
+      const int32_t h = region_hexes[i];
+      if (!composite_of[i]->positive)
+        throw OperationError("sheet refinement: the refinement of input hex " + std::to_string(h) +
+                             " is inverted even on the reference cube");
+      check[h] = !hex_is_parallelepiped(mesh, h);
+    }
+    for (int32_t i = 0; i < applied.mesh.hex_count(); ++i)
+      if (check[applied.parent[i]] && !hex_corners_positive(applied.mesh, i))
+        throw OperationError("sheet refinement: a hex refined from input hex " +
+                             std::to_string(applied.parent[i]) +
+                             " is inverted (non-positive corner Jacobian)");
+  }
+  return {std::move(applied.mesh), std::move(applied.parent)};
+}
+
 // One refinement of `targets` of `mesh`; statistics are accumulated into `stats`.
 PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
                        const SheetControl& control, RefineStats& stats) {
@@ -518,6 +866,17 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
     round_count = piece_count;
   }
 
+  auto piece_name = [&](int32_t p) { return edge_name(piece_edge[p]); };
+  // Without an observer of the intermediate meshes or Harris' one-sheet-per-pass schedule,
+  // every hex's rounds are replayed once per configuration on a reference cube and applied as
+  // one composite template (same mesh, no intermediate meshes or topologies).
+  if (control.composites && !control.observer && !control.one_sheet_per_round) {
+    PassOutput out = refine_composites(mesh, topology, options, marking.node_marked, region_hexes,
+                                       region.occurrence, color, stats);
+    stats.sheet_passes += piece_count;
+    stats.phase_seconds["sheets"] += seconds_since(t_sheets);
+    return out;
+  }
   // The region with compact node ids.
   {
     std::vector<int32_t> local_of(mesh.points.size(), -1);
@@ -543,108 +902,13 @@ PassOutput refine_once(const HexMesh& mesh, const Targets& targets, const Refine
     region.origin = region_hexes;
   }
 
-  const DirectionalTable& table = directional_table();
-  for (int32_t round = 0; round < round_count; ++round) {
-    const HexMesh& cur = region.mesh;
-    const int32_t count = cur.hex_count();
-    const HexTopology rt = topology_build(cur);
-    std::vector<TemplateApplication> apps;
-    std::vector<int16_t> orientation_of(count, -1);
-    std::vector<uint8_t> axes_of(count, 0);  // axes refined in this round
-    for (int32_t h = 0; h < count; ++h) {
-      auto& occ = region.occurrence[h];
-      uint8_t axes = 0;
-      int32_t piece = -1;
-      for (int k = 0; k < 3; ++k) {
-        if (occ[k] < 0 || color[occ[k]] != round) continue;
-        // Two pieces of one colour never share a hex; one piece twice is a self-intersection.
-        if (piece >= 0 && occ[k] != piece)
-          throw OperationError("sheet refinement: a hex descending from input hex " +
-                               std::to_string(region.origin[h]) +
-                               " would be refined in two directions in one round (sheets of "
-                               "edges " +
-                               edge_name(piece_edge[piece]) + " and " +
-                               edge_name(piece_edge[occ[k]]) + ")");
-        piece = occ[k];
-        axes |= static_cast<uint8_t>(1u << k);
-      }
-      if (!axes) continue;
-      uint16_t wanted = 0;
-      for (int k = 0; k < 3; ++k)
-        if (axes & (1u << k)) {
-          wanted |= axis_mask(k);
-          occ[k] = -1;
-        }
-      const uint16_t split = hex_split_mask(cur, region.node_marked, h) & wanted;
-      if (!split) continue;
-      const int16_t o = table.by_mask[split];
-      if (o < 0)
-        throw OperationError("sheet refinement: a hex descending from input hex " +
-                             std::to_string(region.origin[h]) +
-                             " has a split pattern with no directional template (" +
-                             std::to_string(std::popcount(split)) + " edges split in " +
-                             std::to_string(std::popcount(axes)) +
-                             " directions) in the sheet of edge " + edge_name(piece_edge[piece]));
-      orientation_of[h] = o;
-      axes_of[h] = table.orientations[o].axes;
-      apps.push_back({h, table.orientations[o].tmpl, table.orientations[o].symmetry});
-    }
-    // Conformity by construction needs every hex around a split edge to split it in this round.
-    for (const TemplateApplication& a : apps) {
-      const uint16_t split = hex_split_mask(cur, region.node_marked, a.hex);
-      for (int e = 0; e < 12; ++e) {
-        if (!(split & (1u << e)) || !(axes_of[a.hex] & (1u << hex_edge_axis[e]))) continue;
-        const int32_t id = rt.hex_edge_ids[a.hex][e];
-        for (int32_t g : edge_hexes(rt, id)) {
-          const int le = hex_local_edge(rt, g, id);
-          if (!(axes_of[g] & (1u << hex_edge_axis[le])))
-            throw OperationError("sheet refinement: hexes descending from input hexes " +
-                                 std::to_string(region.origin[a.hex]) + " and " +
-                                 std::to_string(region.origin[g]) +
-                                 " do not split their shared edge in the same sheet pass");
-        }
-      }
-    }
-    for (int32_t p = 0; p < piece_count; ++p) stats.sheet_passes += color[p] == round;
-
-    TemplateApplyResult applied = templates_apply(cur, rt, apps);
-    stats.hexes_created += applied.hexes_created;
-    stats.hexes_deleted += applied.hexes_deleted;
-
-    // The next state: occurrences inherited through the children's axes, edge nodes marked.
-    const int32_t out_count = applied.mesh.hex_count();
-    std::vector<std::array<int32_t, 3>> occurrence(out_count);
-    std::vector<int32_t> origin(out_count);
-    std::vector<uint8_t> marked = std::move(region.node_marked);
-    marked.resize(applied.mesh.points.size(), 0);
-    int32_t previous_parent = -1, child = 0;
-    for (int32_t i = 0; i < out_count; ++i) {
-      const int32_t parent = applied.parent[i];
-      child = parent == previous_parent ? child + 1 : 0;
-      previous_parent = parent;
-      origin[i] = region.origin[parent];
-      const int16_t o = orientation_of[parent];
-      if (o < 0) {
-        occurrence[i] = region.occurrence[parent];
-        continue;
-      }
-      const Orientation& orient = table.orientations[o];
-      for (int k = 0; k < 3; ++k) {
-        // The parent's refined axes were set to -1 above: children are done in them.
-        const int p = orient.child_axis[child][k];
-        occurrence[i][k] = p < 0 ? -1 : region.occurrence[parent][p];
-      }
-      const uint8_t edge_nodes = orient.child_edge_nodes[child];
-      for (int j = 0; j < 8; ++j)
-        if (edge_nodes & (1u << j)) marked[applied.mesh.hexes[i][j]] = 1;
-    }
-    region.mesh = std::move(applied.mesh);
-    region.mesh.attributes.clear();
-    region.occurrence = std::move(occurrence);
-    region.origin = std::move(origin);
-    region.node_marked = std::move(marked);
-    if (control.observer) control.observer(region_assemble(mesh, affected, region).mesh, round);
-  }
+  stats.sheet_passes += piece_count;
+  const RoundCounts counts =
+      region_run_rounds(region, color, round_count, piece_name, [&](int32_t round) {
+        if (control.observer) control.observer(region_assemble(mesh, affected, region).mesh, round);
+      });
+  stats.hexes_created += counts.created;
+  stats.hexes_deleted += counts.deleted;
 
   if (!options.allow_inverted)
     for (int32_t h = 0; h < region.mesh.hex_count(); ++h)
@@ -745,8 +1009,7 @@ RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const Ref
 
   stats.final_hexes = result.mesh.hex_count();
   stats.final_nodes = result.mesh.point_count();
-  for (int32_t tag : *mesh_find_attribute(result.mesh, attribute_template_tag))
-    ++stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(tag))];
+  stats_count_templates(stats, *mesh_find_attribute(result.mesh, attribute_template_tag));
   stats.time_seconds = seconds_since(t0);
   stats.phase_seconds["total"] = stats.time_seconds;
   return result;

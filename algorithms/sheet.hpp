@@ -74,6 +74,13 @@ struct SheetControl {
   /// Harris' order: one sheet piece per round, in piece order, instead of all the pieces that
   /// share no hex together. Same result; one copy of the refined region per sheet (slower).
   bool one_sheet_per_round = false;
+  /// Replay each hex configuration's rounds once on the reference cube and apply the result as
+  /// one composite template (the default; the same mesh up to rounding in transition hexes,
+  /// whose later nodes are placed by the input hex's map instead of the intermediate hex's).
+  /// false, an observer or one_sheet_per_round: the rounds run on the whole refined region,
+  /// building every intermediate mesh and its topology (Harris' formulation, as the thesis
+  /// timed it).
+  bool composites = true;
 };
 
 /// As above, with a schedule and an observer.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
@@ -149,6 +150,7 @@ class TemplateBuilder {
 
   HexTemplate take() {
     template_compute_child_axes(t_);
+    template_compile(t_);
     return std::move(t_);
   }
 
@@ -224,8 +226,18 @@ bool cell_map_sixths(const TemplateCell& cell, const std::array<int64_t, 3>& p6,
 }  // namespace
 
 TemplateRefiner::TemplateRefiner(const HexMesh& mesh, const HexTopology& topology)
-    : mesh_(mesh), topology_(topology), points_(mesh.points) {
-  nodes_.reserve(mesh.points.size());
+    : mesh_(mesh),
+      topology_(topology),
+      points_(mesh.points),
+      edge_slot_(3 * static_cast<size_t>(topology.edge_count()), -1),
+      face_base_(topology.face_count(), -1) {
+  // Address space only: pages are touched as faces are first used.
+  face_slot_.reserve(9 * static_cast<size_t>(topology.face_count()));
+}
+
+void TemplateRefiner::reserve_created(size_t nodes) {
+  points_.reserve(points_.size() + nodes);
+  if (record_keys_) created_keys_.reserve(created_keys_.size() + nodes);
 }
 
 TemplateCell TemplateRefiner::cell_whole(int32_t hex) const {
@@ -287,29 +299,95 @@ TemplateNodeKey TemplateRefiner::key_at(int32_t hex, const TemplateParam& p) con
   return make_key(TemplateNodeKey::interior, hex, p[0] * (kUnit + 1) + p[1], p[2]);
 }
 
+int32_t* TemplateRefiner::slot_of(const TemplateNodeKey& key) {
+  // Slots cover the positions templates use on whole hexes and on the first level of
+  // sub-cells: thirds and halves (sixths 2, 3, 4) along an edge and in both directions of a
+  // face. 1/6 and 5/6 occur only deeper or at adjustments and go to the hash table.
+  constexpr int64_t sixth = kUnit / 6;
+  auto index = [](int64_t x) -> int {
+    if (x % sixth != 0) return -1;
+    const int64_t i = x / sixth - 2;
+    return i >= 0 && i < 3 ? static_cast<int>(i) : -1;
+  };
+  const int64_t id = key.entity & 0xFFFFFFFFFF;
+  switch (key.kind()) {
+    case TemplateNodeKey::edge: {
+      const int i = index(key.a);
+      return i < 0 ? nullptr : &edge_slot_[3 * id + i];
+    }
+    case TemplateNodeKey::face: {
+      const int i = index(key.a), j = index(key.b);
+      if (i < 0 || j < 0) return nullptr;
+      int32_t& base = face_base_[id];
+      if (base < 0) {
+        base = static_cast<int32_t>(face_slot_.size());
+        face_slot_.resize(face_slot_.size() + 9, -1);
+      }
+      return &face_slot_[base + 3 * i + j];
+    }
+    default:
+      return nullptr;
+  }
+}
+
+const TemplateNodeKey* TemplateRefiner::alias_of(const TemplateNodeKey& key) const {
+  if (aliases_.empty()) return nullptr;
+  if (key.kind() == TemplateNodeKey::face) {
+    if (!face_aliased_[key.entity & 0xFFFFFFFFFF]) return nullptr;
+  } else if (other_aliases_ == 0) {
+    return nullptr;
+  }
+  const auto it = aliases_.find(key);
+  return it == aliases_.end() ? nullptr : &it->second;
+}
+
+int32_t TemplateRefiner::find_node(const TemplateNodeKey& key) {
+  if (key.kind() == TemplateNodeKey::corner) return static_cast<int32_t>(key.entity & 0xFFFFFFFFFF);
+  if (const int32_t* s = slot_of(key)) return *s;
+  const auto it = nodes_.find(key);
+  return it == nodes_.end() ? -1 : it->second;
+}
+
+int32_t TemplateRefiner::create_node(const TemplateNodeKey& key, const Eigen::Vector3d& x) {
+  points_.push_back(x);
+  if (record_keys_) created_keys_.push_back(key);
+  return static_cast<int32_t>(points_.size() - 1);
+}
+
 bool TemplateRefiner::alias(const TemplateNodeKey& from, const TemplateNodeKey& to) {
   // Too late if a node was already created under `from`: cells made before would keep it.
-  if (nodes_.count(from)) return false;
+  if (find_node(from) >= 0) return false;
   auto [it, inserted] = aliases_.emplace(from, to);
+  if (inserted) {
+    if (from.kind() == TemplateNodeKey::face) {
+      if (face_aliased_.empty()) face_aliased_.assign(topology_.face_count(), 0);
+      face_aliased_[from.entity & 0xFFFFFFFFFF] = 1;
+    } else {
+      ++other_aliases_;
+    }
+  }
   return inserted || it->second == to;
 }
 
 int32_t TemplateRefiner::node_of(const TemplateNodeKey& key, const Eigen::Vector3d& x,
                                  bool* aliased) {
-  TemplateNodeKey k = key;
-  if (!aliases_.empty()) {
-    const auto it = aliases_.find(key);
-    if (it != aliases_.end()) {
-      k = it->second;
-      if (aliased) *aliased = true;
-    }
-  }
+  return node_at(
+      key, [&] { return x; }, aliased);
+}
+
+template <class Position>
+int32_t TemplateRefiner::node_at(const TemplateNodeKey& key, const Position& position,
+                                 bool* aliased) {
+  const TemplateNodeKey* target = alias_of(key);
+  if (target && aliased) *aliased = true;
+  const TemplateNodeKey& k = target ? *target : key;
   if (k.kind() == TemplateNodeKey::corner) return static_cast<int32_t>(k.entity & 0xFFFFFFFFFF);
-  const auto [it, inserted] = nodes_.emplace(k, static_cast<int32_t>(points_.size()));
-  if (inserted) {
-    points_.push_back(x);
-    created_keys_.push_back(k);
+  if (int32_t* s = slot_of(k)) {
+    if (*s < 0) *s = create_node(k, position());
+    return *s;
   }
+  const auto [it, inserted] = nodes_.emplace(k, static_cast<int32_t>(points_.size()));
+  if (inserted) create_node(k, position());
   return it->second;
 }
 
@@ -355,13 +433,8 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
   };
   if (!cell.exact && !cell.whole) fail("a sub-hex with inexact corners cannot be refined again");
 
-  struct Placed {
-    int32_t node;
-    TemplateParam param;
-    TemplateNodeKey key;
-    bool exact, aliased;
-  };
-  std::vector<Placed> placed(t.nodes.size());
+  std::vector<Placed>& placed = placed_;
+  placed.resize(t.nodes.size());
   for (size_t i = 0; i < t.nodes.size(); ++i) {
     const TemplateNode& tn = t.nodes[i];
     const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
@@ -409,10 +482,8 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
       bool interior = true;
       for (int k = 0; k < 3; ++k) interior = interior && p[k] > 1e-12 && p[k] < 1 - 1e-12;
       if (!interior) fail("a node on the cell's boundary is off the exact grid");
-      points_.push_back(position);
-      out.node = static_cast<int32_t>(points_.size() - 1);
-      out.key = make_key(TemplateNodeKey::fresh, out.node);
-      created_keys_.push_back(out.key);
+      out.key = make_key(TemplateNodeKey::fresh, static_cast<int32_t>(points_.size()));
+      out.node = create_node(out.key, position);
       continue;
     }
     out.key = key_at(h, out.param);
@@ -459,9 +530,271 @@ void TemplateRefiner::apply(const TemplateCell& cell, const HexTemplate& t, int 
   }
 }
 
+void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
+                                  bool interior_private, std::vector<HexCell>& children) {
+  const HexCell& input = mesh_.hexes[h];
+  bool distinct = true;
+  for (int a = 0; a < 8; ++a)
+    for (int b = a + 1; b < 8; ++b) distinct = distinct && input[a] != input[b];
+  if (t.plans.empty() || t.plans[symmetry].generic || !distinct) {
+    std::vector<TemplateCell> cells;
+    apply(cell_whole(h), t, symmetry, cells);
+    for (const TemplateCell& c : cells) children.push_back(c.nodes);
+    return;
+  }
+  const TemplatePlan& plan = t.plans[symmetry];
+  std::array<Eigen::Vector3d, 8> x;
+  for (int v = 0; v < 8; ++v) x[v] = mesh_.points[input[v]];
+  // The canonical frame of each face (as key_at): origin vertex and the u and v neighbours.
+  std::array<std::array<int8_t, 3>, 6> frame;
+  for (int lf = 0; lf < 6; ++lf) frame[lf][0] = -1;
+  bool aliased = false;
+  placed_ids_.resize(plan.nodes.size());
+  for (size_t i = 0; i < plan.nodes.size(); ++i) {
+    const TemplatePlanNode& n = plan.nodes[i];
+    auto position = [&] {
+      Eigen::Vector3d out = Eigen::Vector3d::Zero();
+      for (int v = 0; v < 8; ++v) out += n.weight[v] * x[v];
+      return out;
+    };
+    int32_t id = -1;
+    switch (n.kind) {
+      case TemplateNodeKey::corner:
+        id = input[n.local];
+        break;
+      case TemplateNodeKey::edge:
+      case TemplateNodeKey::face:
+        id = node_at(plan_node_key(h, n, frame), position, &aliased);
+        break;
+      default: {
+        const TemplateNodeKey key = make_key(TemplateNodeKey::interior, h,
+                                             n.param[0] * (kUnit + 1) + n.param[1], n.param[2]);
+        id = interior_private ? create_node(key, position()) : node_at(key, position, &aliased);
+        break;
+      }
+    }
+    placed_ids_[i] = id;
+  }
+  if (aliased)
+    for (size_t i = 0; i < placed_ids_.size(); ++i)
+      for (size_t j = i + 1; j < placed_ids_.size(); ++j)
+        if (placed_ids_[i] == placed_ids_[j])
+          throw OperationError("hex " + std::to_string(h) + " (" + template_tag_name(t.tag) +
+                               "): two template nodes fall on one node (the cell is degenerate)");
+  for (const auto& c : plan.children) {
+    HexCell out;
+    for (int k = 0; k < 8; ++k) out[k] = placed_ids_[c[k]];
+    children.push_back(out);
+  }
+}
+
+TemplateNodeKey TemplateRefiner::plan_node_key(int32_t h, const TemplatePlanNode& n,
+                                               std::array<std::array<int8_t, 3>, 6>& frame) const {
+  const HexCell& input = mesh_.hexes[h];
+  if (n.kind == TemplateNodeKey::edge) {
+    const int le = n.local;
+    const int32_t e = topology_.hex_edge_ids[h][le];
+    const int axis = hex_edge_axis[le];
+    int64_t t = hex_corner[hex_edges[le][0]][axis] ? kUnit - n.param[axis] : n.param[axis];
+    if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t = kUnit - t;
+    return make_key(TemplateNodeKey::edge, e, t);
+  }
+  // The canonical frame of the face (as key_at): origin at its lowest node id, u towards the
+  // lower-id neighbour; computed once per face and hex (frame[lf][0] < 0: not yet).
+  const int lf = n.local;
+  auto& fr = frame[lf];
+  if (fr[0] < 0) {
+    int i0 = 0;
+    for (int c = 1; c < 4; ++c)
+      if (input[hex_faces[lf][c]] < input[hex_faces[lf][i0]]) i0 = c;
+    const int step =
+        input[hex_faces[lf][(i0 + 1) % 4]] < input[hex_faces[lf][(i0 + 3) % 4]] ? 1 : 3;
+    fr = {static_cast<int8_t>(hex_faces[lf][i0]),
+          static_cast<int8_t>(hex_faces[lf][(i0 + step) % 4]),
+          static_cast<int8_t>(hex_faces[lf][(i0 + 3 * step) % 4])};
+  }
+  const int* o = hex_corner[fr[0]];
+  const int* c1 = hex_corner[fr[1]];
+  const int* c3 = hex_corner[fr[2]];
+  int64_t u = 0, v = 0;
+  for (int k = 0; k < 3; ++k) {
+    u += (c1[k] - o[k]) * (n.param[k] - o[k] * kUnit);
+    v += (c3[k] - o[k]) * (n.param[k] - o[k] * kUnit);
+  }
+  return make_key(TemplateNodeKey::face, topology_.hex_face_ids[h][lf], u, v);
+}
+
+void TemplateRefiner::apply_whole_batch(std::span<const TemplateApplication> apps,
+                                        std::span<const size_t> child_offset,
+                                        std::vector<HexCell>& children, int threads) {
+  bool parallel = threads > 1 && aliases_.empty() && apps.size() > 1;
+  for (const TemplateApplication& a : apps) {
+    if (!parallel) break;
+    const HexTemplate& t = *a.tmpl;
+    parallel = !t.plans.empty() && !t.plans[a.symmetry].generic && t.plans[a.symmetry].slotted;
+    const HexCell& c = mesh_.hexes[a.hex];
+    for (int i = 0; i < 8 && parallel; ++i)
+      for (int j = i + 1; j < 8; ++j) parallel = parallel && c[i] != c[j];
+  }
+  if (!parallel) {
+    std::vector<HexCell> out;
+    for (size_t i = 0; i < apps.size(); ++i) {
+      out.clear();
+      apply_whole(apps[i].hex, *apps[i].tmpl, apps[i].symmetry, true, out);
+      std::copy(out.begin(), out.end(),
+                children.begin() + static_cast<std::ptrdiff_t>(child_offset[i]));
+    }
+    return;
+  }
+  // 1. Claim node ids in order, exactly as the serial calls would create them.
+  const int32_t first_free = static_cast<int32_t>(points_.size());
+  std::vector<int32_t> first_new(apps.size() + 1);
+  int32_t next = first_free;
+  std::array<std::array<int8_t, 3>, 6> frame;
+  for (size_t i = 0; i < apps.size(); ++i) {
+    first_new[i] = next;
+    const TemplatePlan& plan = apps[i].tmpl->plans[apps[i].symmetry];
+    for (auto& f : frame) f[0] = -1;
+    for (const TemplatePlanNode& n : plan.nodes) {
+      if (n.kind == TemplateNodeKey::corner) continue;
+      if (n.kind == TemplateNodeKey::interior) {
+        ++next;
+        continue;
+      }
+      int32_t* s = slot_of(plan_node_key(apps[i].hex, n, frame));
+      if (*s < 0) *s = next++;
+    }
+  }
+  first_new[apps.size()] = next;
+  points_.resize(static_cast<size_t>(next));  // Eigen leaves them uninitialised: no page touched
+  if (record_keys_) created_keys_.resize(static_cast<size_t>(next) - mesh_.points.size());
+  // 2. Positions, keys and children, in contiguous runs of applications.
+  auto run = [&](size_t begin, size_t end) {
+    std::array<std::array<int8_t, 3>, 6> fr;
+    std::vector<int32_t> ids;
+    for (size_t i = begin; i < end; ++i) {
+      const int32_t h = apps[i].hex;
+      const HexCell& input = mesh_.hexes[h];
+      const TemplatePlan& plan = apps[i].tmpl->plans[apps[i].symmetry];
+      std::array<Eigen::Vector3d, 8> x;
+      for (int v = 0; v < 8; ++v) x[v] = mesh_.points[input[v]];
+      for (auto& f : fr) f[0] = -1;
+      ids.resize(plan.nodes.size());
+      int32_t own = first_new[i];
+      for (size_t j = 0; j < plan.nodes.size(); ++j) {
+        const TemplatePlanNode& n = plan.nodes[j];
+        TemplateNodeKey key;
+        int32_t id;
+        if (n.kind == TemplateNodeKey::corner) {
+          ids[j] = input[n.local];
+          continue;
+        }
+        if (n.kind == TemplateNodeKey::interior) {
+          key = make_key(TemplateNodeKey::interior, h, n.param[0] * (kUnit + 1) + n.param[1],
+                         n.param[2]);
+          id = own++;
+        } else {
+          key = plan_node_key(h, n, fr);
+          id = *slot_of(key);
+          if (id < first_new[i]) {
+            ids[j] = id;
+            continue;
+          }
+          ++own;
+        }
+        ids[j] = id;
+        Eigen::Vector3d p = Eigen::Vector3d::Zero();
+        for (int v = 0; v < 8; ++v) p += n.weight[v] * x[v];
+        points_[id] = p;
+        if (record_keys_) created_keys_[id - mesh_.points.size()] = key;
+      }
+      HexCell* out = children.data() + child_offset[i];
+      for (const auto& c : plan.children) {
+        for (int k = 0; k < 8; ++k) (*out)[k] = ids[c[k]];
+        ++out;
+      }
+    }
+  };
+  const size_t parts = std::min<size_t>(static_cast<size_t>(threads), apps.size());
+  std::vector<std::thread> workers;
+  for (size_t p = 1; p < parts; ++p)
+    workers.emplace_back(run, apps.size() * p / parts, apps.size() * (p + 1) / parts);
+  run(0, apps.size() / parts);
+  for (std::thread& w : workers) w.join();
+}
+
+void template_compile(HexTemplate& t) {
+  t.plans.assign(48, {});
+  for (int sym = 0; sym < 48; ++sym) {
+    const CubeSymmetry& s = cube_symmetries()[sym];
+    TemplatePlan& plan = t.plans[sym];
+    for (const TemplateNode& tn : t.nodes) {
+      TemplatePlanNode n;
+      const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
+      // Exact positions: multiples of 1 / template_param_unit (thirds and sixths of the
+      // standard templates, and the finer positions of composites built from them).
+      bool on_grid = true;
+      int extreme = 0, free_axis = -1, fixed_axis = -1;
+      for (int k = 0; k < 3; ++k) {
+        const double scaled = p[k] * double(kUnit);
+        const int64_t q = std::llround(scaled);
+        on_grid = on_grid && std::abs(scaled - double(q)) < 1e-3 && q >= 0 && q <= kUnit;
+        n.param[k] = q;
+        if (q == 0 || q == kUnit) {
+          ++extreme;
+          fixed_axis = k;
+        } else {
+          free_axis = k;
+        }
+      }
+      // The same weights as the generic path's trilinear(x, param / unit).
+      for (int v = 0; v < 8; ++v) {
+        double w = 1.0;
+        for (int k = 0; k < 3; ++k) {
+          const double r = double(n.param[k]) / kUnit;
+          w *= hex_corner[v][k] ? r : 1.0 - r;
+        }
+        n.weight[v] = w;
+      }
+      // Slot grid: sixths 2, 3 and 4 (TemplateRefiner::slot_of), in every free coordinate.
+      bool slot_grid = true;
+      for (int k = 0; k < 3; ++k) {
+        const int64_t q = n.param[k];
+        if (q == 0 || q == kUnit) continue;
+        slot_grid =
+            slot_grid && q % (kUnit / 6) == 0 && q / (kUnit / 6) >= 2 && q / (kUnit / 6) <= 4;
+      }
+      if (tn.adjustment_edge >= 0 || !on_grid) {
+        plan.generic = true;
+      } else if (extreme == 3) {
+        n.kind = TemplateNodeKey::corner;
+        n.local = static_cast<int8_t>(
+            vertex_of({int(n.param[0] / kUnit), int(n.param[1] / kUnit), int(n.param[2] / kUnit)}));
+      } else if (extreme == 2) {
+        plan.slotted = plan.slotted && slot_grid;
+        n.kind = TemplateNodeKey::edge;
+        n.local = static_cast<int8_t>(local_edge_at(
+            {double(n.param[0] / kUnit), double(n.param[1] / kUnit), double(n.param[2] / kUnit)},
+            free_axis));
+      } else if (extreme == 1) {
+        plan.slotted = plan.slotted && slot_grid;
+        n.kind = TemplateNodeKey::face;
+        n.local = static_cast<int8_t>(2 * fixed_axis + (n.param[fixed_axis] == kUnit ? 1 : 0));
+      } else {
+        n.kind = TemplateNodeKey::interior;
+      }
+      plan.nodes.push_back(n);
+    }
+    for (std::array<int16_t, 8> c : t.children) {
+      if (s.reflection) c = {c[0], c[3], c[2], c[1], c[4], c[7], c[6], c[5]};
+      plan.children.push_back(c);
+    }
+  }
+}
+
 TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topology,
                                     std::span<const TemplateApplication> applications,
-                                    std::span<const TemplateFaceAlias> aliases) {
+                                    std::span<const TemplateFaceAlias> aliases, int threads) {
   const int32_t nh = mesh.hex_count();
   std::vector<int32_t> application_of(nh, -1);
   for (size_t i = 0; i < applications.size(); ++i) {
@@ -480,29 +813,54 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
 
   TemplateApplyResult out;
   HexMesh& res = out.mesh;
-  res.hexes.reserve(mesh.hexes.size());
-  out.parent.reserve(mesh.hexes.size());
-  std::vector<TemplateCell> children;
+  size_t out_hexes = mesh.hexes.size(), new_nodes = 0;
+  for (const TemplateApplication& a : applications) {
+    out_hexes += a.tmpl->children.size() - 1;
+    new_nodes += a.tmpl->nodes.size();
+  }
+  refiner.reserve_created(new_nodes);
+  // One thread: children appended as they are made. More: slots laid out first, the batch
+  // fills the template hexes' slots in parallel.
+  const bool parallel = threads > 1;
+  if (parallel)
+    res.hexes.resize(out_hexes);
+  else
+    res.hexes.reserve(out_hexes);
+  out.parent.reserve(out_hexes);
+  std::vector<size_t> offsets;
+  std::vector<TemplateApplication> ordered;
+  size_t at = 0;
   for (int32_t h = 0; h < nh; ++h) {
     const int32_t a = application_of[h];
     if (a < 0) {
-      res.hexes.push_back(mesh.hexes[h]);
-      out.parent.push_back(h);
-      continue;
+      if (parallel)
+        res.hexes[at] = mesh.hexes[h];
+      else
+        res.hexes.push_back(mesh.hexes[h]);
+      ++at;
+    } else {
+      if (parallel) {
+        ordered.push_back(applications[a]);
+        offsets.push_back(at);
+      } else {
+        try {
+          refiner.apply_whole(h, *applications[a].tmpl, applications[a].symmetry, true, res.hexes);
+        } catch (const OperationError& e) {
+          throw OperationError(std::string("templates_apply: ") + e.what());
+        }
+      }
+      at += applications[a].tmpl->children.size();
+      out.hexes_created += static_cast<int64_t>(applications[a].tmpl->children.size());
+      out.hexes_deleted += 1;
     }
-    children.clear();
+    out.parent.resize(at, h);
+  }
+  if (parallel) {
     try {
-      refiner.apply(refiner.cell_whole(h), *applications[a].tmpl, applications[a].symmetry,
-                    children);
+      refiner.apply_whole_batch(ordered, offsets, res.hexes, threads);
     } catch (const OperationError& e) {
       throw OperationError(std::string("templates_apply: ") + e.what());
     }
-    for (const TemplateCell& c : children) {
-      res.hexes.push_back(c.nodes);
-      out.parent.push_back(h);
-    }
-    out.hexes_created += static_cast<int64_t>(children.size());
-    out.hexes_deleted += 1;
   }
   res.points = std::move(refiner.points());
 
@@ -599,6 +957,7 @@ const HexTemplate& template_1_27() {
                                 id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
                                 id(i, j + 1, k + 1)});
     template_compute_child_axes(r);
+    template_compile(r);
     return r;
   }();
   return t;
@@ -617,6 +976,7 @@ const HexTemplate& template_1_3() {
       r.children.push_back({id(i, 0, 0), id(i + 1, 0, 0), id(i + 1, 1, 0), id(i, 1, 0), id(i, 0, 1),
                             id(i + 1, 0, 1), id(i + 1, 1, 1), id(i, 1, 1)});
     template_compute_child_axes(r);
+    template_compile(r);
     return r;
   }();
   return t;

@@ -21,7 +21,12 @@
 /// Because every cell derives the same key for the same edge/face position, neighbours share
 /// nodes and conformity holds by construction. Nodes are positioned by the input hex's trilinear
 /// map at their exact position; on a shared face both hexes' maps agree (the bilinear face map).
-/// Keys live in one hash table (TemplateRefiner): O(1) per node, no node-pair map.
+/// Node lookup (TemplateRefiner) goes through flat slot arrays wherever a key lies on the
+/// thirds-and-halves grid of its entity: three slots per input edge, nine per input face
+/// (allocated on first use). Only keys off that grid (sub-cells nested deeper, adjustment nodes)
+/// and interior nodes shared by sub-cells go to a hash table. Templates are compiled once per cube
+/// symmetry (TemplatePlan) so that refining a whole input hex is a table walk: no per-node search,
+/// no allocation, no hash lookup.
 
 #include <array>
 #include <cstdint>
@@ -44,6 +49,27 @@ struct TemplateNode {
   int8_t adjustment_index = 0;  ///< which adjustment node of that edge (ordered along the edge)
 };
 
+/// One template node as seen from a whole input hex in one cube symmetry.
+struct TemplatePlanNode {
+  /// TemplateNodeKey::Kind of the node (corner, edge, face or interior), or -1 if it needs the
+  /// generic path (an adjustment node, or a position off the sixths grid).
+  int8_t kind = -1;
+  int8_t local = -1;               ///< local vertex, edge or face of the hex (by kind)
+  std::array<int64_t, 3> param{};  ///< exact position in the hex's cube (template_param_unit)
+  std::array<double, 8> weight{};  ///< trilinear weights of the hex corners at that position
+};
+
+/// A template compiled for one cube symmetry: nodes classified by the entity of the hex they
+/// lie on, children already re-oriented for the symmetry (positive in the hex's frame).
+struct TemplatePlan {
+  std::vector<TemplatePlanNode> nodes;
+  std::vector<std::array<int16_t, 8>> children;
+  bool generic = false;  ///< some node needs the generic path (TemplateRefiner::apply)
+  /// Every edge and face node lies on the slot grid (thirds and halves): the plan can be
+  /// applied in parallel (TemplateRefiner::apply_whole_batch).
+  bool slotted = true;
+};
+
 /// A template in canonical orientation. Children are 8 node indices each, VTK order, positively
 /// oriented in the reference cube.
 struct HexTemplate {
@@ -57,10 +83,17 @@ struct HexTemplate {
   /// round from the split x-edge, so that direction belongs to x. Filled by
   /// template_compute_child_axes.
   std::vector<std::array<int8_t, 3>> child_axis;
+  /// Per cube symmetry (48): the compiled template (template_compile); empty if not compiled,
+  /// in which case TemplateRefiner::apply_whole takes the generic path.
+  std::vector<TemplatePlan> plans;
 };
 
 /// Fills tmpl.child_axis.
 void template_compute_child_axes(HexTemplate& tmpl);
+
+/// Fills tmpl.plans (48 symmetries). The standard templates are compiled when built; a template
+/// assembled by hand must be compiled again after its nodes or children change.
+void template_compile(HexTemplate& tmpl);
 
 /// One of the 48 symmetries of the cube: reference point p maps to
 /// q[k] = flip[k] ? 1 - p[axis[k]] : p[axis[k]].
@@ -188,14 +221,28 @@ class TemplateRefiner {
              std::vector<TemplateCell>& children,
              std::vector<TemplateNodeKey>* node_keys = nullptr);
 
+  /// Applies `tmpl` in orientation `symmetry` to the whole input hex `hex` and appends the
+  /// children's node ids to `children`; the same nodes as apply(cell_whole(hex), ...) would give,
+  /// through the compiled plan (falls back to apply() for templates with adjustment nodes or
+  /// without plans). `interior_private`: the hex gets no other application (no sub-cell of it is
+  /// ever refined), so nodes strictly inside it are created without keying them for sharing.
+  /// Precondition: the hex's eight node ids are distinct. Throws OperationError as apply().
+  void apply_whole(int32_t hex, const HexTemplate& tmpl, int symmetry, bool interior_private,
+                   std::vector<HexCell>& children);
+
   /// Key of the template node `node` (with its position `local_ref` in the cell's frame, i.e.
   /// already mapped by the symmetry) as apply() would place it; throws OperationError if the
   /// position is not exact.
   TemplateNodeKey key_of_template_node(const TemplateCell& cell, int symmetry,
                                        const TemplateNode& node) const;
 
-  /// Key of every node created so far, indexed by node id - input point count.
+  /// Key of every node created so far, indexed by node id - input point count (while
+  /// record_keys is on, the default).
   const std::vector<TemplateNodeKey>& created_keys() const { return created_keys_; }
+  /// Switches recording created_keys off (or on again): saves 24 bytes per node when no one
+  /// asks for the keys. Precondition for switching off: no node created yet, or the keys
+  /// recorded so far are not needed.
+  void set_record_keys(bool on) { record_keys_ = on; }
 
   /// Key adjustment nodes of whole cells by their exact position inside the hex (like those of
   /// sub-cells) instead of by (edge, index): needed when the cells around an adjustment are
@@ -207,15 +254,55 @@ class TemplateRefiner {
   const std::vector<Eigen::Vector3d>& points() const { return points_; }
   std::vector<Eigen::Vector3d>& points() { return points_; }
 
+  /// apply_whole on every application in order, interior nodes private, children written to
+  /// children[child_offset[i] + c] (children sized by the caller): the same node ids, positions,
+  /// keys and children as the serial calls, with the positions and children of up to `threads`
+  /// contiguous runs of applications written in parallel after the node ids have been claimed
+  /// in order. Serial when threads <= 1, when aliases exist or a plan is not slotted.
+  /// Preconditions: ascending distinct hexes, each given once.
+  void apply_whole_batch(std::span<const TemplateApplication> applications,
+                         std::span<const size_t> child_offset, std::vector<HexCell>& children,
+                         int threads);
+
+  /// Reserves room for `nodes` created nodes (an estimate: saves reallocating the outputs).
+  void reserve_created(size_t nodes);
+
  private:
   int32_t node_of(const TemplateNodeKey& key, const Eigen::Vector3d& x, bool* aliased);
+  /// node_of with the position computed (position()) only if the node is created.
+  template <class Position>
+  int32_t node_at(const TemplateNodeKey& key, const Position& position, bool* aliased);
+  /// The slot array entry of a key on the sixths grid of an edge or a face, or nullptr (the
+  /// key is looked up in the hash table). The pointer is valid until the next slot call.
+  int32_t* slot_of(const TemplateNodeKey& key);
+  /// The node created under `key` (after aliasing), or -1.
+  int32_t find_node(const TemplateNodeKey& key);
+  int32_t create_node(const TemplateNodeKey& key, const Eigen::Vector3d& x);
+  const TemplateNodeKey* alias_of(const TemplateNodeKey& key) const;
   const HexMesh& mesh_;
   const HexTopology& topology_;
   std::vector<Eigen::Vector3d> points_;
   std::vector<TemplateNodeKey> created_keys_;
   bool adjustment_by_position_ = false;
+  bool record_keys_ = true;
+  std::vector<int32_t> edge_slot_;     ///< 3 per input edge: sixths 2, 3, 4 in the edge's direction
+  std::vector<int32_t> face_base_;     ///< per input face: offset into face_slot_, or -1
+  std::vector<int32_t> face_slot_;     ///< 9 per used face: (u6 - 2) * 3 + (v6 - 2), u6, v6 in 2..4
+  std::vector<uint8_t> face_aliased_;  ///< per input face: some key on it is aliased
+  int64_t other_aliases_ = 0;          ///< aliases whose source is not a face key
   std::unordered_map<TemplateNodeKey, int32_t, TemplateNodeKeyHash> nodes_;
   std::unordered_map<TemplateNodeKey, TemplateNodeKey, TemplateNodeKeyHash> aliases_;
+  struct Placed {
+    int32_t node;
+    TemplateParam param;
+    TemplateNodeKey key;
+    bool exact, aliased;
+  };
+  std::vector<Placed> placed_;       ///< scratch of apply()
+  std::vector<int32_t> placed_ids_;  ///< scratch of apply_whole()
+  /// Key of a compiled edge or face node of a whole hex (kind edge or face only).
+  TemplateNodeKey plan_node_key(int32_t hex, const TemplatePlanNode& n,
+                                std::array<std::array<int8_t, 3>, 6>& frame) const;
 };
 
 /// Applies every template application to its hex at once and returns the new mesh: untouched
@@ -224,11 +311,12 @@ class TemplateRefiner {
 /// "template_tag" set from each template's tag (untouched hexes keep theirs, or 0); and
 /// "refinement_level" incremented for children.
 /// Preconditions: at most one application per hex; `topology` built from `mesh`.
-/// Throws OperationError if a template asks for more distinct nodes on one edge or face than
-/// a slot can hold (a template bug), naming the hex.
+/// `threads`: see RefineOptions::threads (the output does not depend on it).
+/// Throws OperationError if a cell is degenerate, naming the hex.
 TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topology,
                                     std::span<const TemplateApplication> applications,
-                                    std::span<const TemplateFaceAlias> aliases = {});
+                                    std::span<const TemplateFaceAlias> aliases = {},
+                                    int threads = 1);
 
 /// The standard templates in canonical orientation (see templates.cpp for each template's
 /// split-edge pattern and construction). Only the ones defined so far are listed.

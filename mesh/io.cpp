@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "mesh/error.hpp"
 #include "mesh/io_text.hpp"
@@ -21,10 +20,22 @@ namespace io_detail {
 std::string file_read_all(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open for reading (missing or not readable)");
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  // A regular file is read straight into a string of its size (a read that large bypasses the
+  // stream's buffer); then whatever follows (a pipe has no size, a file may have grown) is
+  // appended in pieces.
+  std::string text;
+  std::error_code ec;
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size < (uintmax_t{1} << 40)) {
+    text.resize(static_cast<size_t>(size));
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<size_t>(in.gcount()));
+  }
+  char piece[1 << 16];
+  while (in && (in.read(piece, sizeof piece), in.gcount() > 0))
+    text.append(piece, static_cast<size_t>(in.gcount()));
   if (in.bad()) throw InputError(path + ": read failed");
-  return std::move(ss).str();
+  return text;
 }
 
 int64_t IdIndex::build(const std::vector<int64_t>& ids) {
@@ -86,12 +97,6 @@ void mesh_check_read(const HexMesh& mesh, const std::string& path) {
                      std::to_string(f[3]) + " (0-based) is shared by more than two hexes (" +
                      std::to_string(t.nonmanifold_faces.size()) + " such faces)");
   }
-}
-
-std::string real_text(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
 }
 
 }  // namespace io_detail

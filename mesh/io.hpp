@@ -70,7 +70,8 @@ HexMesh mesh_read_from_memory(const std::string& name, std::string_view bytes);
 
 /// Writes `mesh` atomically (temporary file + rename). Throws InputError for a mesh the format
 /// cannot hold (e.g. a bad attribute name), OperationError if the file cannot be written.
-/// ASCII formats print 17 significant digits, so coordinates read back exactly.
+/// ASCII formats print each double in the shortest decimal form that reads back as the same
+/// double (std::to_chars), so coordinates read back exactly.
 void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOptions& options = {});
 
 }  // namespace hexrefine

@@ -32,9 +32,10 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-/// Splits at commas (trimmed fields; a trailing comma gives no empty last field).
-std::vector<std::string_view> split_commas(std::string_view line) {
-  std::vector<std::string_view> out;
+/// Splits at commas into `out` (trimmed fields; a trailing comma gives no empty last field).
+/// The caller reuses `out` from line to line, so data lines allocate nothing.
+void split_commas(std::string_view line, std::vector<std::string_view>& out) {
+  out.clear();
   size_t start = 0;
   while (start <= line.size()) {
     const size_t comma = line.find(',', start);
@@ -44,7 +45,6 @@ std::vector<std::string_view> split_commas(std::string_view line) {
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
-  return out;
 }
 
 /// Value of keyword parameter `key` (e.g. TYPE) in a keyword line's fields, "" if absent.
@@ -99,6 +99,7 @@ HexMesh abaqus_read(const std::string& path, const std::string& text) {
   int64_t generated = 0;  // ids listed by GENERATE rows so far
   const int64_t generate_limit = 4 * static_cast<int64_t>(text.size()) + 1024;
   bool saw_keyword = false;
+  std::vector<std::string_view> fields, f;  // reused for every line
   while (in.remaining() > 0) {
     const int64_t line_no = in.line();
     std::string_view line = trim(in.rest_of_line());
@@ -108,7 +109,7 @@ HexMesh abaqus_read(const std::string& path, const std::string& text) {
     if (line.empty() || line.substr(0, 2) == "**") continue;
     if (line[0] == '*') {
       saw_keyword = true;
-      const std::vector<std::string_view> fields = split_commas(line.substr(1));
+      split_commas(line.substr(1), fields);
       const std::string key = upper(fields[0]);
       mode = Mode::skip;
       if (key == "INCLUDE")
@@ -154,7 +155,7 @@ HexMesh abaqus_read(const std::string& path, const std::string& text) {
       }
       line = joined;
     }
-    const std::vector<std::string_view> f = split_commas(line);
+    split_commas(line, f);
     auto integer = [&](std::string_view t, const char* what) {
       int64_t v = 0;
       if (!TextCursor::parse_integer(t, v))
@@ -256,24 +257,18 @@ HexMesh abaqus_read(const std::string& path, const std::string& text) {
 void abaqus_write(const std::string& path, const HexMesh& mesh) {
   const std::vector<int32_t>* block = mesh_find_attribute(mesh, attribute_block_id);
   file_write_atomically(path, [&](std::ostream& out) {
-    std::string s;
-    const io_detail::ChunkFlush flush{out, s};
-    s += "*HEADING\nhexrefine mesh\n*NODE\n";
+    TextWriter w(out);
+    w.text("*HEADING\nhexrefine mesh\n*NODE\n");
     for (size_t i = 0; i < mesh.points.size(); ++i) {
       const Eigen::Vector3d& p = mesh.points[i];
-      s += std::to_string(i + 1) + ", " + real_text(p.x()) + ", " + real_text(p.y()) + ", " +
-           real_text(p.z()) + "\n";
-      flush(false);
+      w.integer(static_cast<int64_t>(i) + 1).text(", ").real(p.x()).text(", ").real(p.y());
+      w.text(", ").real(p.z()).put('\n');
     }
-    s += "*ELEMENT, TYPE=C3D8\n";
+    w.text("*ELEMENT, TYPE=C3D8\n");
     for (size_t h = 0; h < mesh.hexes.size(); ++h) {
-      s += std::to_string(h + 1);
-      for (int32_t v : mesh.hexes[h]) {
-        s += ", ";
-        s += std::to_string(v + 1);
-      }
-      s += "\n";
-      flush(false);
+      w.integer(static_cast<int64_t>(h) + 1);
+      for (int32_t v : mesh.hexes[h]) w.text(", ").integer(int64_t{v} + 1);
+      w.put('\n');
     }
     if (block != nullptr) {
       std::vector<std::pair<int32_t, int32_t>> order(block->size());
@@ -282,13 +277,12 @@ void abaqus_write(const std::string& path, const HexMesh& mesh) {
       for (size_t i = 0; i < order.size(); ++i) {
         const bool first = i == 0 || order[i].first != order[i - 1].first;
         const bool last = i + 1 == order.size() || order[i + 1].first != order[i].first;
-        if (first) s += "*ELSET, ELSET=BLOCK_" + std::to_string(order[i].first) + "\n";
-        s += std::to_string(order[i].second + 1);
-        s += (last || (i % 16) == 15) ? "\n" : ", ";
-        flush(false);
+        if (first) w.text("*ELSET, ELSET=BLOCK_").integer(order[i].first).put('\n');
+        w.integer(int64_t{order[i].second} + 1);
+        w.text((last || (i % 16) == 15) ? "\n" : ", ");
       }
     }
-    flush(true);
+    w.flush();
   });
 }
 

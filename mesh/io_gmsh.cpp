@@ -321,10 +321,9 @@ void gmsh_write(const std::string& path, const HexMesh& mesh,
   for (const auto& [b, h] : order)
     if (blocks.empty() || blocks.back() != b) blocks.push_back(b);
   file_write_atomically(path, [&](std::ostream& out) {
-    std::string s;
-    const io_detail::ChunkFlush flush{out, s};
-    s += "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
-    s += "$Entities\n0 0 0 " + std::to_string(blocks.size()) + "\n";
+    TextWriter w(out);
+    w.text("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
+    w.text("$Entities\n0 0 0 ").integer(static_cast<int64_t>(blocks.size())).put('\n');
     size_t i = 0;
     for (size_t e = 0; e < blocks.size(); ++e) {
       Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -333,66 +332,55 @@ void gmsh_write(const std::string& path, const HexMesh& mesh,
           lo = lo.cwiseMin(mesh.points[v]);
           hi = hi.cwiseMax(mesh.points[v]);
         }
-      s += std::to_string(e + 1);
-      for (int k = 0; k < 6; ++k) {
-        s.push_back(' ');
-        s += real_text(k < 3 ? lo[k] : hi[k - 3]);
-      }
-      s += blocks[e] > 0 ? " 1 " + std::to_string(blocks[e]) + " 0\n" : " 0 0\n";
+      w.integer(static_cast<int64_t>(e) + 1);
+      for (int k = 0; k < 6; ++k) w.put(' ').real(k < 3 ? lo[k] : hi[k - 3]);
+      if (blocks[e] > 0)
+        w.text(" 1 ").integer(blocks[e]).text(" 0\n");
+      else
+        w.text(" 0 0\n");
     }
-    s += "$EndEntities\n$Nodes\n";
-    s += "1 " + std::to_string(n) + " " + (n ? "1 " : "0 ") + std::to_string(n) + "\n";
-    s += "3 1 0 " + std::to_string(n) + "\n";
-    for (size_t v = 0; v < n; ++v) {
-      s += std::to_string(v + 1) + "\n";
-      flush(false);
-    }
-    for (const Eigen::Vector3d& p : mesh.points) {
-      s += real_text(p.x()) + " " + real_text(p.y()) + " " + real_text(p.z()) + "\n";
-      flush(false);
-    }
-    s += "$EndNodes\n$Elements\n";
-    s += std::to_string(blocks.size()) + " " + std::to_string(m) + " " + (m ? "1 " : "0 ") +
-         std::to_string(m) + "\n";
+    const int64_t n64 = static_cast<int64_t>(n), m64 = static_cast<int64_t>(m);
+    w.text("$EndEntities\n$Nodes\n");
+    w.text("1 ").integer(n64).text(n ? " 1 " : " 0 ").integer(n64).put('\n');
+    w.text("3 1 0 ").integer(n64).put('\n');
+    for (int64_t v = 1; v <= n64; ++v) w.integer(v).put('\n');
+    for (const Eigen::Vector3d& p : mesh.points)
+      w.real(p.x()).put(' ').real(p.y()).put(' ').real(p.z()).put('\n');
+    w.text("$EndNodes\n$Elements\n");
+    w.integer(static_cast<int64_t>(blocks.size())).put(' ').integer(m64);
+    w.text(m ? " 1 " : " 0 ").integer(m64).put('\n');
     i = 0;
     for (size_t e = 0; e < blocks.size(); ++e) {
       size_t j = i;
       while (j < m && order[j].first == blocks[e]) ++j;
-      s += "3 " + std::to_string(e + 1) + " 5 " + std::to_string(j - i) + "\n";
+      w.text("3 ").integer(static_cast<int64_t>(e) + 1).text(" 5 ");
+      w.integer(static_cast<int64_t>(j - i)).put('\n');
       for (; i < j; ++i) {
         const int32_t h = order[i].second;
-        s += std::to_string(h + 1);
-        for (int32_t v : mesh.hexes[h]) {
-          s += " ";
-          s += std::to_string(v + 1);
-        }
-        s += "\n";
-        flush(false);
+        w.integer(int64_t{h} + 1);
+        for (int32_t v : mesh.hexes[h]) w.put(' ').integer(int64_t{v} + 1);
+        w.put('\n');
       }
     }
-    s += "$EndElements\n";
+    w.text("$EndElements\n");
     auto data_header = [&](const std::string& name) {
-      s += "$ElementData\n1\n\"" + name + "\"\n1\n0\n3\n0\n1\n" + std::to_string(m) + "\n";
+      w.text("$ElementData\n1\n\"").text(name).text("\"\n1\n0\n3\n0\n1\n").integer(m64).put('\n');
     };
     if (m > 0) {
       for (const HexAttribute& a : mesh.attributes) {
         data_header(a.name);
-        for (size_t h = 0; h < m; ++h) {
-          s += std::to_string(h + 1) + " " + std::to_string(a.values[h]) + "\n";
-          flush(false);
-        }
-        s += "$EndElementData\n";
+        for (size_t h = 0; h < m; ++h)
+          w.integer(static_cast<int64_t>(h) + 1).put(' ').integer(a.values[h]).put('\n');
+        w.text("$EndElementData\n");
       }
       for (const auto& [name, values] : cell_scalars) {
         data_header(name);
-        for (size_t h = 0; h < m; ++h) {
-          s += std::to_string(h + 1) + " " + real_text(values[h]) + "\n";
-          flush(false);
-        }
-        s += "$EndElementData\n";
+        for (size_t h = 0; h < m; ++h)
+          w.integer(static_cast<int64_t>(h) + 1).put(' ').real(values[h]).put('\n');
+        w.text("$EndElementData\n");
       }
     }
-    flush(true);
+    w.flush();
   });
 }
 

@@ -93,10 +93,10 @@ HexMesh medit_read(const std::string& path, const std::string& text) {
       if (s->volume && n > 0)
         in.fail("the mesh has " + std::to_string(n) + " " + s->name +
                 ": only linear hexahedra are supported (skipping them would leave holes)");
+      const std::string entry = std::string(s->name) + " entry";
       for (int64_t i = 0; i < n; ++i) {
-        for (int k = 0; k < s->nodes + s->ints + (s->nodes > 0 ? 1 : 0); ++k)
-          in.integer(std::string(s->name) + " entry");
-        for (int k = 0; k < s->reals; ++k) in.real(std::string(s->name) + " entry");
+        for (int k = 0; k < s->nodes + s->ints + (s->nodes > 0 ? 1 : 0); ++k) in.integer(entry);
+        for (int k = 0; k < s->reals; ++k) in.real(entry);
       }
     }
   }
@@ -108,26 +108,18 @@ HexMesh medit_read(const std::string& path, const std::string& text) {
 void medit_write(const std::string& path, const HexMesh& mesh) {
   const std::vector<int32_t>* block = mesh_find_attribute(mesh, attribute_block_id);
   file_write_atomically(path, [&](std::ostream& out) {
-    std::string s;
-    s.reserve(1 << 16);
-    auto flush = [&] {
-      out.write(s.data(), static_cast<std::streamsize>(s.size()));
-      s.clear();
-    };
-    s += "MeshVersionFormatted 2\nDimension 3\nVertices\n";
-    s += std::to_string(mesh.points.size()) + "\n";
-    for (const Eigen::Vector3d& p : mesh.points) {
-      s += real_text(p.x()) + " " + real_text(p.y()) + " " + real_text(p.z()) + " 0\n";
-      if (s.size() > (1 << 16)) flush();
-    }
-    s += "Hexahedra\n" + std::to_string(mesh.hexes.size()) + "\n";
+    TextWriter w(out);
+    w.text("MeshVersionFormatted 2\nDimension 3\nVertices\n");
+    w.integer(static_cast<int64_t>(mesh.points.size())).put('\n');
+    for (const Eigen::Vector3d& p : mesh.points)
+      w.real(p.x()).put(' ').real(p.y()).put(' ').real(p.z()).text(" 0\n");
+    w.text("Hexahedra\n").integer(static_cast<int64_t>(mesh.hexes.size())).put('\n');
     for (size_t h = 0; h < mesh.hexes.size(); ++h) {
-      for (int32_t v : mesh.hexes[h]) s += std::to_string(v + 1) + " ";
-      s += std::to_string(block ? (*block)[h] : 0) + "\n";
-      if (s.size() > (1 << 16)) flush();
+      for (int32_t v : mesh.hexes[h]) w.integer(int64_t{v} + 1).put(' ');
+      w.integer(block ? (*block)[h] : 0).put('\n');
     }
-    s += "End\n";
-    flush();
+    w.text("End\n");
+    w.flush();
   });
 }
 

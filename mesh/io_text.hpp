@@ -1,15 +1,22 @@
 #pragma once
 /// \file
-/// Private to the mesh readers: a whole-file buffer with a line-counting tokenizer, number parsing
-/// that refuses garbage, NaN and infinity, and size checks made before anything is allocated.
+/// Private to the mesh readers and writers. Readers: a whole-file buffer with a line-counting
+/// tokenizer, number parsing that refuses garbage, NaN and infinity, and size checks made before
+/// anything is allocated. Writers: TextWriter, one buffer that numbers are formatted into with
+/// std::to_chars and that goes to the stream in large chunks.
 
+#include <algorithm>
+#include <array>
+#include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "mesh/error.hpp"
@@ -23,11 +30,23 @@ std::string file_read_all(const std::string& path);
 /// Tokens separated by white space (and by `extra_separators`, e.g. "," for Abaqus); `comment`
 /// (if not 0) starts a comment running to the end of the line. Tracks the 1-based line number
 /// of the last token for error messages. The text is borrowed: it must outlive the cursor.
+/// `what` arguments (what the caller expects, for messages) are string views so that the hot
+/// per-token calls with a literal build no std::string; messages are built only on failure.
 class TextCursor {
  public:
   TextCursor(const std::string& path, std::string_view text, char comment = 0,
              const char* extra_separators = "")
-      : path_(path), text_(text), comment_(comment), extra_(extra_separators) {}
+      : path_(path), text_(text), comment_(comment) {
+    // Byte classes as tables: the tokenizer looks at every byte of the file.
+    for (const char c : {' ', '\t', '\r', '\f', '\v'}) blank_[static_cast<unsigned char>(c)] = true;
+    for (const char* e = extra_separators; *e != 0; ++e)
+      blank_[static_cast<unsigned char>(*e)] = true;
+    stop_ = blank_;
+    stop_['\n'] = true;
+    // comment == 0 means "no comment character": a NUL byte is then part of the token (which
+    // will not parse), never an empty token that would stall a caller's loop.
+    if (comment_ != 0) stop_[static_cast<unsigned char>(comment_)] = true;
+  }
 
   const std::string& path() const { return path_; }
   /// For a cursor over a slice of a file: the line number of the slice's first byte.
@@ -49,15 +68,11 @@ class TextCursor {
   }
 
   /// The next token; at the end of the file fails with "unexpected end of file, expected <what>".
-  std::string_view token(const std::string& what) {
+  std::string_view token(std::string_view what) {
     skip_space();
-    if (pos_ >= text_.size()) fail("unexpected end of file, expected " + what);
+    if (pos_ >= text_.size()) fail("unexpected end of file, expected " + std::string(what));
     const size_t start = pos_;
-    // comment_ == 0 means "no comment character": a NUL byte is then part of the token (which
-    // will not parse), never an empty token that would stall a caller's loop.
-    while (pos_ < text_.size() && !is_space(text_[pos_]) && !is_extra(text_[pos_]) &&
-           (comment_ == 0 || text_[pos_] != comment_))
-      ++pos_;
+    while (pos_ < text_.size() && !stop_[static_cast<unsigned char>(text_[pos_])]) ++pos_;
     return text_.substr(start, pos_ - start);
   }
 
@@ -76,27 +91,29 @@ class TextCursor {
   }
 
   /// An integer token; fails naming `what` on anything else.
-  int64_t integer(const std::string& what) {
+  int64_t integer(std::string_view what) {
     const std::string_view t = token(what);
     int64_t v = 0;
-    if (!parse_integer(t, v)) fail("expected " + what + " (an integer), got '" + shown(t) + "'");
+    if (!parse_integer(t, v))
+      fail("expected " + std::string(what) + " (an integer), got '" + shown(t) + "'");
     return v;
   }
 
   /// An integer in [lo, hi].
-  int64_t integer_in(const std::string& what, int64_t lo, int64_t hi) {
+  int64_t integer_in(std::string_view what, int64_t lo, int64_t hi) {
     const int64_t v = integer(what);
     if (v < lo || v > hi)
-      fail("expected " + what + " in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
-           std::to_string(v));
+      fail("expected " + std::string(what) + " in " + std::to_string(lo) + ".." +
+           std::to_string(hi) + ", got " + std::to_string(v));
     return v;
   }
 
   /// A finite real token.
-  double real(const std::string& what) {
+  double real(std::string_view what) {
     const std::string_view t = token(what);
     double v = 0;
-    if (!parse_real(t, v)) fail("expected " + what + " (a finite number), got '" + shown(t) + "'");
+    if (!parse_real(t, v))
+      fail("expected " + std::string(what) + " (a finite number), got '" + shown(t) + "'");
     return v;
   }
 
@@ -111,19 +128,20 @@ class TextCursor {
 
   /// A count in [0, limit] whose items need at least `min_bytes_each` bytes of what remains of
   /// the file; checked before the caller allocates anything.
-  int64_t count(const std::string& what, int64_t min_bytes_each, int64_t limit = INT32_MAX) {
+  int64_t count(std::string_view what, int64_t min_bytes_each, int64_t limit = INT32_MAX) {
     const int64_t n = integer(what);
     check_count(n, what, min_bytes_each, limit);
     return n;
   }
 
-  void check_count(int64_t n, const std::string& what, int64_t min_bytes_each,
+  void check_count(int64_t n, std::string_view what, int64_t min_bytes_each,
                    int64_t limit = INT32_MAX) const {
-    if (n < 0) fail("expected " + what + " >= 0, got " + std::to_string(n));
+    if (n < 0) fail("expected " + std::string(what) + " >= 0, got " + std::to_string(n));
     if (n > limit)
-      fail(what + " " + std::to_string(n) + " exceeds the limit " + std::to_string(limit));
+      fail(std::string(what) + " " + std::to_string(n) + " exceeds the limit " +
+           std::to_string(limit));
     if (min_bytes_each > 0 && n > static_cast<int64_t>(remaining()) / min_bytes_each)
-      fail(what + " " + std::to_string(n) + " is more than the rest of the file (" +
+      fail(std::string(what) + " " + std::to_string(n) + " is more than the rest of the file (" +
            std::to_string(remaining()) + " bytes) can hold");
   }
 
@@ -144,10 +162,10 @@ class TextCursor {
   }
 
   /// `n` raw bytes (for binary blocks), consumed; fails naming `what` if the file is shorter.
-  const char* raw(size_t n, const std::string& what) {
+  const char* raw(size_t n, std::string_view what) {
     if (n > remaining())
-      fail("file ends inside " + what + " (" + std::to_string(n) + " bytes expected, " +
-           std::to_string(remaining()) + " left)");
+      fail("file ends inside " + std::string(what) + " (" + std::to_string(n) +
+           " bytes expected, " + std::to_string(remaining()) + " left)");
     const char* p = text_.data() + pos_;
     for (size_t i = 0; i < n; ++i)
       if (p[i] == '\n') ++line_;
@@ -182,16 +200,12 @@ class TextCursor {
   }
 
  private:
-  static bool is_space(char c) {
-    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
-  }
-  bool is_extra(char c) const { return c != 0 && std::strchr(extra_, c) != nullptr; }
   void skip_space() {
     while (pos_ < text_.size()) {
       const char c = text_[pos_];
       if (c == '\n') {
         ++line_, ++pos_;
-      } else if (is_space(c) || is_extra(c)) {
+      } else if (blank_[static_cast<unsigned char>(c)]) {
         ++pos_;
       } else if (comment_ != 0 && c == comment_) {
         while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
@@ -204,7 +218,8 @@ class TextCursor {
   std::string path_;
   std::string_view text_;
   char comment_;
-  const char* extra_;
+  std::array<bool, 256> blank_{};  ///< white space other than '\n', and the extra separators
+  std::array<bool, 256> stop_{};   ///< ends a token: blank_, '\n' and the comment character
   size_t pos_ = 0;
   int64_t line_ = 1;
 };
@@ -247,24 +262,38 @@ bool items_sort_by_permutation_ids(std::vector<T>& items, std::vector<int64_t>& 
 /// face shared by more than two hexes (message names the face's nodes, 0-based).
 void mesh_check_read(const HexMesh& mesh, const std::string& path);
 
-/// Prints a double with 17 significant digits (round-trips exactly).
-std::string real_text(double v);
-
-/// Appends `v` in big-endian byte order (VTK legacy binary).
+/// `v` with its bytes in big-endian order (VTK legacy binary), for 2-, 4- and 8-byte numbers.
 template <class T>
-void append_big_endian(std::string& out, T v) {
-  char b[sizeof(T)];
-  std::memcpy(b, &v, sizeof(T));
-  for (size_t i = 0; i < sizeof(T); ++i) out.push_back(b[sizeof(T) - 1 - i]);
+T value_big_endian(T v) {
+  static_assert(std::is_trivially_copyable_v<T> &&
+                (sizeof(T) == 2 || sizeof(T) == 4 || sizeof(T) == 8));
+  static_assert(std::endian::native == std::endian::little ||
+                std::endian::native == std::endian::big);
+  if constexpr (std::endian::native == std::endian::big) {
+    return v;
+  } else {
+    using U = std::conditional_t<sizeof(T) == 2, uint16_t,
+                                 std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t>>;
+    U u;
+    std::memcpy(&u, &v, sizeof u);
+    if constexpr (sizeof(T) == 2)
+      u = __builtin_bswap16(u);
+    else if constexpr (sizeof(T) == 4)
+      u = __builtin_bswap32(u);
+    else
+      u = __builtin_bswap64(u);
+    T r;
+    std::memcpy(&r, &u, sizeof r);
+    return r;
+  }
 }
+
 /// Reads a big-endian value from `p`.
 template <class T>
 T read_big_endian(const char* p) {
-  char b[sizeof(T)];
-  for (size_t i = 0; i < sizeof(T); ++i) b[i] = p[sizeof(T) - 1 - i];
   T v;
-  std::memcpy(&v, b, sizeof(T));
-  return v;
+  std::memcpy(&v, p, sizeof(T));
+  return value_big_endian(v);
 }
 
 // Per-format entry points (io_<format>.cpp); mesh_read / mesh_write dispatch to them. The text
@@ -285,16 +314,90 @@ void exodus_write(const std::string& path, const HexMesh& mesh);
 HexMesh abaqus_read(const std::string& path, const std::string& text);
 void abaqus_write(const std::string& path, const HexMesh& mesh);
 
-/// Writers build text in a string and hand it to the stream in 64 KiB pieces (one write per
-/// piece, not per number): `flush(false)` writes once the piece is full, `flush(true)` always.
-struct ChunkFlush {
-  std::ostream& out;
-  std::string& text;
-  void operator()(bool force) const {
-    if (!force && text.size() < (1 << 16)) return;
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    text.clear();
+/// The writers' output buffer: numbers are formatted straight into one 1 MiB buffer with
+/// std::to_chars (no std::string per number, no locale, no printf parsing) and the buffer goes
+/// to the stream whenever fewer than `item_max` bytes are free, so the stream sees one write
+/// per MiB. Every append makes room for itself, so callers need no size bookkeeping.
+///
+/// Reals are written in the shortest form that reads back as the same double (std::to_chars
+/// without a precision: "0.1", "1e-300", "-0", "5e-324", "1.7976931348623157e+308"), so ASCII
+/// files stay exact and are shorter than with 17 significant digits.
+///
+/// Call flush() once at the end; the destructor does not write (a failed write must surface as
+/// an exception inside file_write_atomically, not be swallowed by a destructor).
+class TextWriter {
+ public:
+  static constexpr size_t capacity = size_t{1} << 20;
+  /// Longer than any one number: a shortest double is at most 24 characters
+  /// ("-2.2250738585072014e-308"), an int64 at most 20.
+  static constexpr size_t item_max = 64;
+
+  explicit TextWriter(std::ostream& out)
+      : out_(out),
+        buffer_(new char[capacity]),
+        pos_(buffer_.get()),
+        end_(buffer_.get() + capacity) {}
+  TextWriter(const TextWriter&) = delete;
+  TextWriter& operator=(const TextWriter&) = delete;
+
+  /// Shortest round-trip decimal form of a finite double (mesh_write refuses NaN and infinity).
+  TextWriter& real(double v) {
+    room();
+    pos_ = std::to_chars(pos_, end_, v).ptr;
+    return *this;
   }
+  TextWriter& integer(int64_t v) {
+    room();
+    pos_ = std::to_chars(pos_, end_, v).ptr;
+    return *this;
+  }
+  TextWriter& put(char c) {
+    room();
+    *pos_++ = c;
+    return *this;
+  }
+  /// Any length (names, headers); long text goes through in pieces.
+  TextWriter& text(std::string_view s) {
+    while (!s.empty()) {
+      room();
+      const size_t n = std::min(s.size(), static_cast<size_t>(end_ - pos_));
+      std::memcpy(pos_, s.data(), n);
+      pos_ += n;
+      s.remove_prefix(n);
+    }
+    return *this;
+  }
+  /// `count` values in big-endian byte order, converted straight into the buffer.
+  template <class T>
+  TextWriter& big_endian(const T* values, size_t count) {
+    while (count > 0) {
+      room();
+      const size_t n = std::min(count, static_cast<size_t>(end_ - pos_) / sizeof(T));
+      for (size_t i = 0; i < n; ++i) {
+        const T v = value_big_endian(values[i]);
+        std::memcpy(pos_ + i * sizeof(T), &v, sizeof(T));
+      }
+      pos_ += n * sizeof(T);
+      values += n;
+      count -= n;
+    }
+    return *this;
+  }
+  /// Hands the buffered bytes to the stream.
+  void flush() {
+    out_.write(buffer_.get(), static_cast<std::streamsize>(pos_ - buffer_.get()));
+    pos_ = buffer_.get();
+  }
+
+ private:
+  void room() {
+    if (static_cast<size_t>(end_ - pos_) < item_max) flush();
+  }
+
+  std::ostream& out_;
+  std::unique_ptr<char[]> buffer_;
+  char* pos_;
+  char* end_;
 };
 
 }  // namespace hexrefine::io_detail

@@ -117,30 +117,53 @@ void vtk_read_values(TextCursor& in, bool binary, std::string_view type, int64_t
   }
   in.rest_of_line();
   const char* p = in.raw(static_cast<size_t>(count) * size, what);
+  // The type is resolved once, not compared as a string per value.
+  enum class Binary { i8, u8, i16, u16, i32, u32, f32, f64, i64, u64 };
+  const Binary kind = type == "char"                                         ? Binary::i8
+                      : type == "unsigned_char"                              ? Binary::u8
+                      : type == "short"                                      ? Binary::i16
+                      : type == "unsigned_short"                             ? Binary::u16
+                      : (type == "int" || type == "vtktypeint32")            ? Binary::i32
+                      : (type == "unsigned_int" || type == "vtktypeuint32")  ? Binary::u32
+                      : type == "float"                                      ? Binary::f32
+                      : type == "double"                                     ? Binary::f64
+                      : (type == "unsigned_long" || type == "vtktypeuint64") ? Binary::u64
+                                                                             : Binary::i64;
   for (int64_t i = 0; i < count; ++i, p += size) {
     double d = 0;
     int64_t v = 0;
-    if (type == "char")
-      v = static_cast<signed char>(*p);
-    else if (type == "unsigned_char")
-      v = static_cast<unsigned char>(*p);
-    else if (type == "short")
-      v = read_big_endian<int16_t>(p);
-    else if (type == "unsigned_short")
-      v = read_big_endian<uint16_t>(p);
-    else if (type == "int" || type == "vtktypeint32")
-      v = read_big_endian<int32_t>(p);
-    else if (type == "unsigned_int" || type == "vtktypeuint32")
-      v = read_big_endian<uint32_t>(p);
-    else if (type == "float")
-      d = read_big_endian<float>(p);
-    else if (type == "double")
-      d = read_big_endian<double>(p);
-    else {
-      const uint64_t u = read_big_endian<uint64_t>(p);
-      if ((type == "unsigned_long" || type == "vtktypeuint64") && u > INT64_MAX)
-        in.fail(what + ": value out of range");
-      v = static_cast<int64_t>(u);
+    switch (kind) {
+      case Binary::i8:
+        v = static_cast<signed char>(*p);
+        break;
+      case Binary::u8:
+        v = static_cast<unsigned char>(*p);
+        break;
+      case Binary::i16:
+        v = read_big_endian<int16_t>(p);
+        break;
+      case Binary::u16:
+        v = read_big_endian<uint16_t>(p);
+        break;
+      case Binary::i32:
+        v = read_big_endian<int32_t>(p);
+        break;
+      case Binary::u32:
+        v = read_big_endian<uint32_t>(p);
+        break;
+      case Binary::f32:
+        d = read_big_endian<float>(p);
+        break;
+      case Binary::f64:
+        d = read_big_endian<double>(p);
+        break;
+      case Binary::i64:
+      case Binary::u64: {
+        const uint64_t u = read_big_endian<uint64_t>(p);
+        if (kind == Binary::u64 && u > INT64_MAX) in.fail(what + ": value out of range");
+        v = static_cast<int64_t>(u);
+        break;
+      }
     }
     if (!is_int && !allow_nonfinite && !std::isfinite(d))
       in.fail(what + " " + std::to_string(i) + " is NaN or infinite");
@@ -404,74 +427,63 @@ HexMesh vtk_read(const std::string& path, const std::string& text) {
 
 void vtk_write(const std::string& path, const HexMesh& mesh, const bool binary,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars) {
+  static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "points must be packed xyz");
   file_write_atomically(path, [&](std::ostream& out) {
-    std::string s;
-    const io_detail::ChunkFlush flush{out, s};
+    TextWriter w(out);
     const size_t n = mesh.points.size(), m = mesh.hexes.size();
-    s += "# vtk DataFile Version 3.0\nhexrefine mesh\n";
-    s += binary ? "BINARY\n" : "ASCII\n";
-    s += "DATASET UNSTRUCTURED_GRID\nPOINTS " + std::to_string(n) + " double\n";
-    for (const Eigen::Vector3d& p : mesh.points) {
-      for (int k = 0; k < 3; ++k) {
-        if (binary)
-          append_big_endian<double>(s, p[k]);
-        else
-          s += real_text(p[k]) + (k < 2 ? " " : "\n");
-      }
-      flush(false);
+    w.text("# vtk DataFile Version 3.0\nhexrefine mesh\n");
+    w.text(binary ? "BINARY\n" : "ASCII\n");
+    w.text("DATASET UNSTRUCTURED_GRID\nPOINTS ").integer(static_cast<int64_t>(n));
+    w.text(" double\n");
+    if (binary) {
+      // The points are one packed array of 3n doubles: swapped into the buffer in one pass.
+      w.big_endian(n ? mesh.points[0].data() : nullptr, 3 * n).put('\n');
+    } else {
+      for (const Eigen::Vector3d& p : mesh.points)
+        w.real(p.x()).put(' ').real(p.y()).put(' ').real(p.z()).put('\n');
     }
-    if (binary) s += "\n";
-    s += "CELLS " + std::to_string(m) + " " + std::to_string(9 * m) + "\n";
+    w.text("CELLS ").integer(static_cast<int64_t>(m)).put(' ');
+    w.integer(9 * static_cast<int64_t>(m)).put('\n');
     for (const HexCell& c : mesh.hexes) {
       if (binary) {
-        append_big_endian<int32_t>(s, 8);
-        for (int32_t v : c) append_big_endian<int32_t>(s, v);
+        const int32_t row[9] = {8, c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]};
+        w.big_endian(row, 9);
       } else {
-        s += "8";
-        for (int32_t v : c) {
-          s.push_back(' ');
-          s += std::to_string(v);
-        }
-        s += "\n";
+        w.put('8');
+        for (int32_t v : c) w.put(' ').integer(v);
+        w.put('\n');
       }
-      flush(false);
     }
-    if (binary) s += "\n";
-    s += "CELL_TYPES " + std::to_string(m) + "\n";
+    if (binary) w.put('\n');
+    w.text("CELL_TYPES ").integer(static_cast<int64_t>(m)).put('\n');
+    const int32_t hexahedron = 12;
     for (size_t h = 0; h < m; ++h) {
       if (binary)
-        append_big_endian<int32_t>(s, 12);
+        w.big_endian(&hexahedron, 1);
       else
-        s += "12\n";
-      flush(false);
+        w.text("12\n");
     }
-    if (binary) s += "\n";
+    if (binary) w.put('\n');
     if (m > 0 && (!mesh.attributes.empty() || !cell_scalars.empty())) {
-      s += "CELL_DATA " + std::to_string(m) + "\n";
+      w.text("CELL_DATA ").integer(static_cast<int64_t>(m)).put('\n');
       for (const HexAttribute& a : mesh.attributes) {
-        s += "SCALARS " + a.name + " int 1\nLOOKUP_TABLE default\n";
-        for (int32_t v : a.values) {
-          if (binary)
-            append_big_endian<int32_t>(s, v);
-          else
-            s += std::to_string(v) + "\n";
-          flush(false);
+        w.text("SCALARS ").text(a.name).text(" int 1\nLOOKUP_TABLE default\n");
+        if (binary) {
+          w.big_endian(a.values.data(), a.values.size()).put('\n');
+        } else {
+          for (int32_t v : a.values) w.integer(v).put('\n');
         }
-        if (binary) s += "\n";
       }
       for (const auto& [name, values] : cell_scalars) {
-        s += "SCALARS " + name + " double 1\nLOOKUP_TABLE default\n";
-        for (double v : values) {
-          if (binary)
-            append_big_endian<double>(s, v);
-          else
-            s += real_text(v) + "\n";
-          flush(false);
+        w.text("SCALARS ").text(name).text(" double 1\nLOOKUP_TABLE default\n");
+        if (binary) {
+          w.big_endian(values.data(), values.size()).put('\n');
+        } else {
+          for (double v : values) w.real(v).put('\n');
         }
-        if (binary) s += "\n";
       }
     }
-    flush(true);
+    w.flush();
   });
 }
 
@@ -482,58 +494,43 @@ namespace hexrefine::io_detail {
 void vtu_write(const std::string& path, const HexMesh& mesh,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars) {
   file_write_atomically(path, [&](std::ostream& out) {
-    std::string s;
-    const io_detail::ChunkFlush flush{out, s};
+    TextWriter w(out);
     const size_t n = mesh.points.size(), m = mesh.hexes.size();
-    s += "<?xml version=\"1.0\"?>\n";
-    s += "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
-         "header_type=\"UInt64\">\n<UnstructuredGrid>\n";
-    s += "<Piece NumberOfPoints=\"" + std::to_string(n) + "\" NumberOfCells=\"" +
-         std::to_string(m) + "\">\n";
-    s += "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const Eigen::Vector3d& p : mesh.points) {
-      s += real_text(p.x()) + " " + real_text(p.y()) + " " + real_text(p.z()) + "\n";
-      flush(false);
-    }
-    s += "</DataArray>\n</Points>\n<Cells>\n";
-    s += "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+    w.text("<?xml version=\"1.0\"?>\n");
+    w.text(
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+        "header_type=\"UInt64\">\n<UnstructuredGrid>\n");
+    w.text("<Piece NumberOfPoints=\"").integer(static_cast<int64_t>(n));
+    w.text("\" NumberOfCells=\"").integer(static_cast<int64_t>(m)).text("\">\n");
+    w.text("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (const Eigen::Vector3d& p : mesh.points)
+      w.real(p.x()).put(' ').real(p.y()).put(' ').real(p.z()).put('\n');
+    w.text("</DataArray>\n</Points>\n<Cells>\n");
+    w.text("<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
     for (const HexCell& c : mesh.hexes) {
-      for (int k = 0; k < 8; ++k) s += std::to_string(c[k]) + (k < 7 ? " " : "\n");
-      flush(false);
+      for (int k = 0; k < 8; ++k) w.integer(c[k]).put(k < 7 ? ' ' : '\n');
     }
-    s += "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (size_t h = 0; h < m; ++h) {
-      s += std::to_string(8 * (h + 1)) + "\n";
-      flush(false);
-    }
-    s += "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-    for (size_t h = 0; h < m; ++h) {
-      s += "12\n";
-      flush(false);
-    }
-    s += "</DataArray>\n</Cells>\n";
+    w.text("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+    for (size_t h = 0; h < m; ++h) w.integer(8 * (static_cast<int64_t>(h) + 1)).put('\n');
+    w.text("</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
+    for (size_t h = 0; h < m; ++h) w.text("12\n");
+    w.text("</DataArray>\n</Cells>\n");
     if (!mesh.attributes.empty() || !cell_scalars.empty()) {
-      s += "<CellData>\n";
+      w.text("<CellData>\n");
       for (const HexAttribute& a : mesh.attributes) {
-        s += "<DataArray type=\"Int32\" Name=\"" + a.name + "\" format=\"ascii\">\n";
-        for (int32_t v : a.values) {
-          s += std::to_string(v) + "\n";
-          flush(false);
-        }
-        s += "</DataArray>\n";
+        w.text("<DataArray type=\"Int32\" Name=\"").text(a.name).text("\" format=\"ascii\">\n");
+        for (int32_t v : a.values) w.integer(v).put('\n');
+        w.text("</DataArray>\n");
       }
       for (const auto& [name, values] : cell_scalars) {
-        s += "<DataArray type=\"Float64\" Name=\"" + name + "\" format=\"ascii\">\n";
-        for (double v : values) {
-          s += real_text(v) + "\n";
-          flush(false);
-        }
-        s += "</DataArray>\n";
+        w.text("<DataArray type=\"Float64\" Name=\"").text(name).text("\" format=\"ascii\">\n");
+        for (double v : values) w.real(v).put('\n');
+        w.text("</DataArray>\n");
       }
-      s += "</CellData>\n";
+      w.text("</CellData>\n");
     }
-    s += "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-    flush(true);
+    w.text("</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    w.flush();
   });
 }
 
@@ -611,6 +608,20 @@ HexMesh vtu_read(const std::string& path, const std::string& text) {
     std::string type;
   };
   std::vector<Pending> cell_arrays;
+  // Section openings and line numbers are followed forward from one array to the next, so the
+  // file is scanned once in all, not once per array.
+  constexpr std::string_view section_names[4] = {"<Points", "<Cells", "<CellData", "<PointData"};
+  int64_t section_at[4] = {-1, -1, -1, -1};  // last opening of each before `scanned`
+  size_t scanned = 0;
+  size_t line_pos = 0;  // line_no is the line of offset line_pos
+  int64_t line_no = 1;
+  auto line_at = [&](size_t pos) {
+    if (pos < line_pos) return line_of(all, pos);
+    line_no += std::count(all.begin() + static_cast<ptrdiff_t>(line_pos),
+                          all.begin() + static_cast<ptrdiff_t>(pos), '\n');
+    line_pos = pos;
+    return line_no;
+  };
   size_t p = piece_end;
   while ((p = all.find("<DataArray", p)) != std::string_view::npos) {
     const size_t tag_end = all.find('>', p);
@@ -622,13 +633,16 @@ HexMesh vtu_read(const std::string& path, const std::string& text) {
     const std::string format = xml_attribute(tag, "format");
     std::string type = xml_attribute(tag, "type");
     const std::string comps = xml_attribute(tag, "NumberOfComponents");
-    // Which section holds this array: the nearest section opening before it.
-    auto last = [&](std::string_view what) {
-      const size_t q = all.rfind(what, p);
-      return q == std::string_view::npos ? -1 : static_cast<int64_t>(q);
-    };
-    const int64_t in_points = last("<Points"), in_cells = last("<Cells"),
-                  in_cell_data = last("<CellData"), in_point_data = last("<PointData");
+    // Which section holds this array: the nearest section opening before it. (No opening can
+    // straddle p: the names hold '<' only first, and p is the '<' of "<DataArray".)
+    const std::string_view before = all.substr(0, p);
+    for (int k = 0; k < 4; ++k)
+      for (size_t q = scanned; (q = before.find(section_names[k], q)) != std::string_view::npos;
+           ++q)
+        section_at[k] = static_cast<int64_t>(q);
+    scanned = p;
+    const int64_t in_points = section_at[0], in_cells = section_at[1], in_cell_data = section_at[2],
+                  in_point_data = section_at[3];
     const int64_t section = std::max({in_points, in_cells, in_cell_data, in_point_data});
     if (format != "ascii")
       fail_at(p, "DataArray '" + name + "' has format \"" + format +
@@ -636,7 +650,7 @@ HexMesh vtu_read(const std::string& path, const std::string& text) {
     // The values end at the first nested element (VTK writes <InformationKey> after them).
     const size_t values_end = std::min(close, all.find('<', tag_end + 1));
     TextCursor in(path, all.substr(tag_end + 1, values_end - tag_end - 1));
-    in.set_line(line_of(all, tag_end + 1));
+    in.set_line(line_at(tag_end + 1));
     const std::string what = "values of DataArray '" + name + "'";
     static const std::pair<const char*, const char*> type_names[] = {
         {"Int8", "char"},     {"UInt8", "unsigned_char"},

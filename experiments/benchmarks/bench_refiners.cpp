@@ -7,18 +7,24 @@
 /// (UseRealTime). Counters: final hexes, hexes created and deleted, sheet passes, added targets,
 /// per-phase seconds (of the last iteration), and `s/initial_hex` (seconds per input hex; flat
 /// when the time grows linearly), `hexes_in/s` and `hexes_out/s` (initial and final hexes per
-/// second) and `peak_rss_MB` (the benchmark's peak resident memory, VmHWM, reset at its start).
-/// Sizes: 10, 25, 50; 10 only under HEXREFINE_BENCH_SMOKE=1 (`hexrefine bench --smoke`); 75 (the
-/// thesis' largest brick: about 6 GB, tens of seconds) only under HEXREFINE_BENCH_LARGE=1.
-/// A refiner that throws (e.g. not implemented yet) is reported
-/// as a skipped benchmark with its message.
+/// second), `output_MB`, `floor_s` and `floor_ratio` (the time to write the output's bytes into
+/// fresh memory in the same run, and our median time over it) and `peak_rss_MB` (the benchmark's
+/// peak resident memory, VmHWM, reset at its start). Sizes: 10, 25, 50; 10 only under
+/// HEXREFINE_BENCH_SMOKE=1 (`hexrefine bench --smoke`); 75 (the thesis' largest brick: about 6 GB,
+/// tens of seconds) only under HEXREFINE_BENCH_LARGE=1. A refiner that throws (e.g. not implemented
+/// yet) is reported as a skipped benchmark with its message.
 ///
 /// Run (Release): bench_refiners --benchmark_repetitions=3
 ///   --benchmark_out=results/benchmarks/refiners.json --benchmark_out_format=json
 #include <benchmark/benchmark.h>
 
+#include <malloc.h>
+
 #include <algorithm>
+#include <chrono>
+#include <cstring>
 #include <exception>
+#include <memory>
 #include <string>
 
 #include "algorithms/selective.hpp"
@@ -29,6 +35,16 @@
 
 namespace hexrefine {
 namespace {
+
+// Every large allocation gets fresh pages from the kernel, at every size, as in a single
+// `hexrefine refine` run. Without this glibc raises its mmap threshold after the first large
+// free, so the small meshes (up to 32 MB) would reuse already-faulted heap memory from the
+// previous iteration while the large ones cannot: the small sizes would look cheaper per hex
+// and the measured growth steeper than it is.
+const int fresh_memory = [] {
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+  return 0;
+}();
 
 using RefineFunction = RefineResult (*)(const HexMesh&, const Targets&, const RefineOptions&);
 const RefineFunction sheet = &sheet_refine;  // picks the overload without an observer
@@ -79,10 +95,14 @@ void run(benchmark::State& state, RefineFunction refine, const HexMesh& mesh,
          const Targets& targets, const RefineOptions& options = {}) {
   RefineStats last;
   bench_reset_peak_memory();
+  std::vector<double> seconds;
   try {
     for (auto _ : state) {
+      const auto t0 = std::chrono::steady_clock::now();
       RefineResult r = refine(mesh, targets, options);
       benchmark::DoNotOptimize(r.mesh.hexes.data());
+      seconds.push_back(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       last = std::move(r.stats);
     }
   } catch (const std::exception& e) {
@@ -104,6 +124,24 @@ void run(benchmark::State& state, RefineFunction refine, const HexMesh& mesh,
   bench_set_hex_rate(state, "hexes_in/s", static_cast<double>(mesh.hex_count()));
   bench_set_hex_rate(state, "hexes_out/s", static_cast<double>(last.final_hexes));
   bench_set_peak_memory(state);
+  // The floor: writing the output's bytes (hexes and nodes) into fresh memory, page faults
+  // included, timed in the same process; floor_ratio = median refine time / median floor time.
+  const size_t bytes = static_cast<size_t>(last.final_hexes) * sizeof(HexCell) +
+                       static_cast<size_t>(last.final_nodes) * sizeof(Eigen::Vector3d);
+  std::vector<double> floor;
+  for (int rep = 0; rep < 3; ++rep) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::unique_ptr<char[]> fresh(new char[bytes]);
+    std::memset(fresh.get(), 0x5a, bytes);
+    benchmark::DoNotOptimize(fresh.get());
+    floor.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(seconds.begin(), seconds.end());
+  std::sort(floor.begin(), floor.end());
+  state.counters["output_MB"] = static_cast<double>(bytes) / 1e6;
+  state.counters["floor_s"] = floor[1];
+  if (!seconds.empty() && floor[1] > 0)
+    state.counters["floor_ratio"] = seconds[seconds.size() / 2] / floor[1];
 }
 
 void bench_full_brick(benchmark::State& state, RefineFunction refine) {
@@ -149,12 +187,38 @@ RefineResult sheet_one_per_pass(const HexMesh& mesh, const Targets& targets,
   return sheet_refine(mesh, targets, options, control);
 }
 
+// The rounds on the whole refined region, every intermediate mesh and topology built (the
+// default replays each hex configuration once as a composite template: same mesh).
+RefineResult sheet_rounds(const HexMesh& mesh, const Targets& targets,
+                          const RefineOptions& options) {
+  SheetControl control;
+  control.composites = false;
+  return sheet_refine(mesh, targets, options, control);
+}
+
+// Both refiners with two threads for the template application (the same output).
+RefineResult selective_2_threads(const HexMesh& mesh, const Targets& targets,
+                                 const RefineOptions& options) {
+  RefineOptions o = options;
+  o.threads = 2;
+  return selective_refine(mesh, targets, o);
+}
+RefineResult sheet_2_threads(const HexMesh& mesh, const Targets& targets,
+                             const RefineOptions& options) {
+  RefineOptions o = options;
+  o.threads = 2;
+  return sheet_refine(mesh, targets, o);
+}
+
 void sizes(benchmark::internal::Benchmark* b) {
   bench_brick_sizes(b, 10, 10);
 }
 
 BENCHMARK_CAPTURE(bench_full_brick, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, selective, selective)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_full_brick, sheet_rounds, &sheet_rounds)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_full_brick, selective_2_threads, &selective_2_threads)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_full_brick, sheet_2_threads, &sheet_2_threads)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_full_brick, sheet_one_per_pass, &sheet_one_per_pass)
     ->Apply([](benchmark::internal::Benchmark* b) {
       if (bench_smoke())
@@ -165,6 +229,7 @@ BENCHMARK_CAPTURE(bench_full_brick, sheet_one_per_pass, &sheet_one_per_pass)
     });
 BENCHMARK_CAPTURE(bench_radial, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_radial, selective, selective)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_radial, sheet_rounds, &sheet_rounds)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_l_shaped, sheet, sheet)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(bench_l_shaped, selective, selective)
     ->Unit(benchmark::kMillisecond)

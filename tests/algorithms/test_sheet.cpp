@@ -610,6 +610,79 @@ TEST(SheetRefine, TwistedRingTransitionInTwoDirectionsOfOneSheetIsRefused) {
   }
 }
 
+TEST(SheetRefine, CompositesGiveTheRoundByRoundMesh) {
+  // The composite replay against the rounds on the whole region: the same outcome (result or
+  // refusal), counts, node count and a valid conformal mesh; on an unjittered brick the same
+  // points (up to rounding).
+  SheetControl rounds;
+  rounds.composites = false;
+  int compared = 0, refused = 0;
+  auto compare = [&](const HexMesh& m, const Targets& t, bool same_points,
+                     const std::string& what) {
+    SCOPED_TRACE(what);
+    std::string error_a, error_b;
+    RefineResult a, b;
+    try {
+      a = sheet_refine(m, t, {});
+    } catch (const OperationError& e) {
+      error_a = e.what();
+    }
+    try {
+      b = sheet_refine(m, t, {}, rounds);
+    } catch (const OperationError& e) {
+      error_b = e.what();
+    }
+    ASSERT_EQ(error_a.empty(), error_b.empty()) << error_a << " | " << error_b;
+    if (!error_a.empty()) {
+      ++refused;
+      return;
+    }
+    EXPECT_EQ(a.mesh.hex_count(), b.mesh.hex_count());
+    EXPECT_EQ(a.mesh.point_count(), b.mesh.point_count());
+    EXPECT_EQ(a.stats.hexes_created, b.stats.hexes_created);
+    EXPECT_EQ(a.stats.hexes_deleted, b.stats.hexes_deleted);
+    EXPECT_EQ(a.stats.sheet_passes, b.stats.sheet_passes);
+    EXPECT_EQ(a.stats.added_targets, b.stats.added_targets);
+    EXPECT_TRUE(mesh_check(a.mesh).valid());
+    if (same_points) {
+      auto sorted = [](std::vector<Eigen::Vector3d> p) {
+        for (auto& x : p)
+          for (int k = 0; k < 3; ++k) x[k] = std::round(x[k] * 1e9) / 1e9;
+        std::sort(p.begin(), p.end(), [](const auto& x, const auto& y) {
+          return std::lexicographical_compare(x.data(), x.data() + 3, y.data(), y.data() + 3);
+        });
+        return p;
+      };
+      EXPECT_EQ(sorted(a.mesh.points), sorted(b.mesh.points));
+    }
+    ++compared;
+  };
+  for (uint32_t seed = 1; seed <= 30; ++seed) {
+    const HexMesh plain = fixture_brick(5, 5, 5);
+    const HexMesh jittered = jittered_brick(5, 0.2, seed);
+    std::mt19937 rng(seed);
+    std::bernoulli_distribution pick(0.05 + 0.01 * (seed % 10));
+    Targets t;
+    for (int32_t h = 0; h < plain.hex_count(); ++h)
+      if (pick(rng)) t.hexes.push_back(h);
+    compare(plain, t, true, "brick seed " + std::to_string(seed));
+    compare(jittered, t, false, "jittered seed " + std::to_string(seed));
+  }
+  TwistedRingParams p;
+  p.section_intervals = 2;
+  const HexMesh ring = generate_twisted_ring(p);
+  for (uint32_t seed = 1; seed <= 20; ++seed) {
+    std::mt19937 rng(seed);
+    std::bernoulli_distribution pick(0.1 + 0.02 * (seed % 10));
+    Targets t;
+    for (int32_t h = 0; h < ring.hex_count(); ++h)
+      if (pick(rng)) t.hexes.push_back(h);
+    compare(ring, t, false, "ring seed " + std::to_string(seed));
+  }
+  EXPECT_EQ(compared + refused, 80);
+  EXPECT_GT(compared, 60);
+}
+
 // Runs the selective refiner, or skips while it is not implemented on this branch.
 #define SELECTIVE_OR_SKIP(result, ...)                                             \
   RefineResult result;                                                             \

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "mesh/error.hpp"
+#include "mesh/generators.hpp"
 #include "mesh/hex_convention.hpp"
 #include "mesh/topology.hpp"
 #include "tests/fixtures.hpp"
@@ -274,6 +275,120 @@ TEST(TemplatesApply, OneToThreeInEverySymmetryStaysConformal) {
     }
   }
   EXPECT_EQ(tried, 16 * 16);  // 16 symmetries map the x-slabs onto the y-slabs
+}
+
+TEST(Templates, BasicTemplatesSubdivideAFaceAsAFunctionOfItsSplitEdges) {
+  // The premise of the selective refiner's self-check (it rebuilds the topology only around
+  // directional and adjusted hexes): any two basic-template faces with the same split sides,
+  // in any symmetry and from either side (all 8 motions of the square), are subdivided alike.
+  const HexTemplate* basic[] = {&template_1_27(), &template_1_13(), &template_1_5(),
+                                &template_1_4(), &template_1_3()};
+  std::map<int, std::set<Quad2>> pattern_of_mask;
+  int faces = 0;
+  for (const HexTemplate* t : basic) {
+    for (int sym = 0; sym < 48; ++sym) {
+      const CubeSymmetry& s = cube_symmetries()[sym];
+      std::vector<std::array<long, 3>> p6;
+      for (const TemplateNode& n : t->nodes) {
+        const auto q = cube_symmetry_apply(s, n.ref);
+        p6.push_back({std::lround(6 * q[0]), std::lround(6 * q[1]), std::lround(6 * q[2])});
+      }
+      for (int lf = 0; lf < 6; ++lf) {
+        const int* o = hex_corner[hex_faces[lf][0]];
+        const int* c1 = hex_corner[hex_faces[lf][1]];
+        const int* c3 = hex_corner[hex_faces[lf][3]];
+        const int axis = lf / 2;
+        const long level = 6 * (lf % 2);
+        auto to2 = [&](const std::array<long, 3>& p) {
+          Point2 r{0, 0};
+          for (int k = 0; k < 3; ++k) {
+            r[0] += (c1[k] - o[k]) * (p[k] - 6 * o[k]);
+            r[1] += (c3[k] - o[k]) * (p[k] - 6 * o[k]);
+          }
+          return r;
+        };
+        std::vector<Quad2> quads;
+        for (auto c : t->children) {
+          if (s.reflection) c = {c[0], c[3], c[2], c[1], c[4], c[7], c[6], c[5]};
+          for (int cf = 0; cf < 6; ++cf) {
+            Quad2 q;
+            bool on = true;
+            for (int i = 0; i < 4; ++i) {
+              on = on && p6[c[hex_faces[cf][i]]][axis] == level;
+              q[i] = to2(p6[c[hex_faces[cf][i]]]);
+            }
+            if (on) quads.push_back(q);
+          }
+        }
+        ASSERT_FALSE(quads.empty());
+        ++faces;
+        for (int motion = 0; motion < 8; ++motion) {
+          std::set<Quad2> image;
+          int mask = 0;
+          for (Quad2 q : quads) {
+            for (Point2& p : q) {
+              long u = p[0], v = p[1];
+              if (motion & 1) u = 6 - u;
+              if (motion & 2) v = 6 - v;
+              if (motion & 4) std::swap(u, v);
+              p = {u, v};
+              if (v == 0 && u > 0 && u < 6) mask |= 1;
+              if (u == 6 && v > 0 && v < 6) mask |= 2;
+              if (v == 6 && u > 0 && u < 6) mask |= 4;
+              if (u == 0 && v > 0 && v < 6) mask |= 8;
+            }
+            image.insert(quad_sorted(q));
+          }
+          const auto [it, inserted] = pattern_of_mask.emplace(mask, image);
+          EXPECT_EQ(it->second, image) << template_tag_name(t->tag) << " symmetry " << sym
+                                       << " face " << lf << " motion " << motion;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(faces, 5 * 48 * 6);
+  // Split sides met: none, one (4 ways), two opposite (2), all four.
+  EXPECT_EQ(pattern_of_mask.size(), 8u);
+}
+
+TEST(TemplateRefiner, CompiledApplicationMatchesTheGenericOne) {
+  // apply_whole walks the compiled plan; apply() derives every key from exact positions. On a
+  // jittered mesh with shuffled node ids both must create the same nodes, in the same order, at
+  // bit-identical positions, under the same keys.
+  BrickParams bp;
+  bp.dims = {3, 3, 3};
+  bp.jitter = 0.2;
+  HexMesh m = generate_brick(bp);
+  std::vector<int32_t> perm(m.point_count());
+  for (int32_t i = 0; i < m.point_count(); ++i) perm[i] = (i * 37) % m.point_count();
+  for (HexCell& c : m.hexes)
+    for (int32_t& v : c) v = perm[v];
+  std::vector<Eigen::Vector3d> pts(m.points.size());
+  for (int32_t i = 0; i < m.point_count(); ++i) pts[perm[i]] = m.points[i];
+  m.points = pts;
+  const HexTopology topo = topology_build(m);
+  const HexTemplate* all[] = {&template_1_27(), &template_1_13(), &template_1_5(), &template_1_4(),
+                              &template_1_3()};
+  int compared = 0;
+  for (const HexTemplate* t : all) {
+    for (int sym = 0; sym < 48; sym += 5) {
+      TemplateRefiner generic(m, topo), compiled(m, topo);
+      std::vector<HexCell> a, b;
+      for (int32_t h = 0; h < m.hex_count(); h += 2) {
+        std::vector<TemplateCell> cells;
+        generic.apply(generic.cell_whole(h), *t, sym, cells);
+        for (const TemplateCell& c : cells) a.push_back(c.nodes);
+        compiled.apply_whole(h, *t, sym, false, b);
+      }
+      ASSERT_EQ(a, b) << template_tag_name(t->tag) << " symmetry " << sym;
+      ASSERT_EQ(generic.points().size(), compiled.points().size());
+      for (size_t i = 0; i < generic.points().size(); ++i)
+        ASSERT_EQ(generic.points()[i], compiled.points()[i]);
+      ASSERT_EQ(generic.created_keys(), compiled.created_keys());
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 5 * 10);
 }
 
 }  // namespace

@@ -15,7 +15,7 @@ TEST(IoMedit, RoundTripKeepsPointsCellsAndBlockId) {
   mesh_write(path, m);
   const HexMesh r = mesh_read(path);
   io_expect_same_geometry(m, r, 1e-12);
-  io_expect_same_geometry(m, r, 0);  // 17 significant digits: exact
+  io_expect_same_geometry(m, r, 0);  // shortest round-trip digits: exact
   io_expect_same_attribute(m, r, attribute_block_id);
   EXPECT_EQ(mesh_find_attribute(r, attribute_template_tag), nullptr);  // MEDIT has one tag only
 }

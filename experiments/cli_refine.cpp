@@ -1,7 +1,7 @@
 /// \file
 /// `hexrefine refine IN OUT --method selective|sheet --select SPEC [--select SPEC ...]
 /// [--passes N] [--buffer] [--smooth] [--no-ranking] [--no-propagation] [--ebe-only]
-/// [--allow-inverted] [--max-hexes N] [--report R.json]`
+/// [--allow-inverted] [--max-hexes N] [--threads N] [--report R.json]`
 ///
 /// OUT (its format and folder) and R are checked before IN is read (cli_output.hpp). The refined
 /// mesh's size is bounded before refining: each pass splits a hex into at most 27, so IN's n hexes
@@ -49,7 +49,7 @@ namespace {
 const char* refine_usage =
     "usage: hexrefine refine IN OUT --method selective|sheet --select SPEC [--select SPEC ...]\n"
     "       [--passes N] [--buffer] [--smooth] [--no-ranking] [--no-propagation] [--ebe-only]\n"
-    "       [--allow-inverted] [--max-hexes N] [--report R.json]\n";
+    "       [--allow-inverted] [--max-hexes N] [--threads N] [--report R.json]\n";
 
 /// n * 27^passes, saturated at INT64_MAX.
 int64_t refine_hex_bound(int64_t hexes, int passes) {
@@ -63,10 +63,10 @@ int64_t refine_hex_bound(int64_t hexes, int passes) {
 }  // namespace
 
 int cli_refine(const std::vector<std::string>& args) {
-  const CliArgs a =
-      cli_parse("refine", args, {"--method", "--select", "--passes", "--report", "--max-hexes"},
-                {"--buffer", "--smooth", "--no-ranking", "--no-propagation", "--ebe-only",
-                 "--allow-inverted"});
+  const CliArgs a = cli_parse(
+      "refine", args, {"--method", "--select", "--passes", "--report", "--max-hexes", "--threads"},
+      {"--buffer", "--smooth", "--no-ranking", "--no-propagation", "--ebe-only",
+       "--allow-inverted"});
   if (a.positional.size() != 2)
     throw InputError(std::string("hexrefine refine: expected IN and OUT\n") + refine_usage);
   const std::string in = a.positional[0], out = a.positional[1];
@@ -88,6 +88,12 @@ int cli_refine(const std::vector<std::string>& args) {
   options.propagation = !a.flag("--no-propagation");
   options.ebe_only = a.flag("--ebe-only");
   options.allow_inverted = a.flag("--allow-inverted");
+  if (const auto t = a.value("--threads")) {
+    const long long n = cli_parse_int(*t, "--threads");
+    if (n < 1 || n > 256)
+      throw InputError("hexrefine refine: --threads must be in 1..256, got " + *t);
+    options.threads = static_cast<int>(n);
+  }
   const bool ablation = !options.ranking || !options.propagation || options.ebe_only;
   int64_t max_hexes = std::numeric_limits<int32_t>::max();
   if (const auto m = a.value("--max-hexes")) {

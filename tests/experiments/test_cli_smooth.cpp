@@ -48,7 +48,7 @@ TEST(CliSmooth, SmoothsWritesMeshAndReport) {
     EXPECT_EQ(j.at("region_hexes").get<int>(), 125);
     EXPECT_DOUBLE_EQ(j.at("min_scaled_jacobian_before").get<double>(),
                      mesh_min_scaled_jacobian(input));
-    // 17 significant digits in the file: the mesh read back has the reported minimum.
+    // Shortest round-trip reals in the file: the mesh read back has the reported minimum.
     EXPECT_NEAR(j.at("min_scaled_jacobian_after").get<double>(), mesh_min_scaled_jacobian(m),
                 1e-12);
     EXPECT_GT(j.at("min_scaled_jacobian_after").get<double>(),

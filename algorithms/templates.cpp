@@ -549,6 +549,7 @@ void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
   std::array<std::array<int8_t, 3>, 6> frame;
   for (int lf = 0; lf < 6; ++lf) frame[lf][0] = -1;
   bool aliased = false;
+  const bool direct = plan.slotted && aliases_.empty() && !record_keys_;
   placed_ids_.resize(plan.nodes.size());
   for (size_t i = 0; i < plan.nodes.size(); ++i) {
     const TemplatePlanNode& n = plan.nodes[i];
@@ -564,7 +565,14 @@ void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
         break;
       case TemplateNodeKey::edge:
       case TemplateNodeKey::face:
-        id = node_at(plan_node_key(h, n, frame), position, &aliased);
+        if (direct) {
+          // Nobody needs the key: straight to the slot.
+          int32_t& s = plan_node_slot(h, n, frame);
+          if (s < 0) s = create_node(TemplateNodeKey{}, position());
+          id = s;
+        } else {
+          id = node_at(plan_node_key(h, n, frame), position, &aliased);
+        }
         break;
       default: {
         const TemplateNodeKey key = make_key(TemplateNodeKey::interior, h,
@@ -588,20 +596,13 @@ void TemplateRefiner::apply_whole(int32_t h, const HexTemplate& t, int symmetry,
   }
 }
 
-TemplateNodeKey TemplateRefiner::plan_node_key(int32_t h, const TemplatePlanNode& n,
-                                               std::array<std::array<int8_t, 3>, 6>& frame) const {
-  const HexCell& input = mesh_.hexes[h];
-  if (n.kind == TemplateNodeKey::edge) {
-    const int le = n.local;
-    const int32_t e = topology_.hex_edge_ids[h][le];
-    const int axis = hex_edge_axis[le];
-    int64_t t = hex_corner[hex_edges[le][0]][axis] ? kUnit - n.param[axis] : n.param[axis];
-    if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t = kUnit - t;
-    return make_key(TemplateNodeKey::edge, e, t);
-  }
-  // The canonical frame of the face (as key_at): origin at its lowest node id, u towards the
-  // lower-id neighbour; computed once per face and hex (frame[lf][0] < 0: not yet).
-  const int lf = n.local;
+namespace {
+
+// The canonical frame of local face lf of a hex with node ids `input` (as key_at): origin at its
+// lowest node id, u towards the lower-id neighbour; computed once per face and hex
+// (frame[lf][0] < 0: not yet). Returns {origin, u corner, v corner} as local vertices.
+const std::array<int8_t, 3>& face_frame(const HexCell& input, int lf,
+                                        std::array<std::array<int8_t, 3>, 6>& frame) {
   auto& fr = frame[lf];
   if (fr[0] < 0) {
     int i0 = 0;
@@ -613,6 +614,53 @@ TemplateNodeKey TemplateRefiner::plan_node_key(int32_t h, const TemplatePlanNode
           static_cast<int8_t>(hex_faces[lf][(i0 + step) % 4]),
           static_cast<int8_t>(hex_faces[lf][(i0 + 3 * step) % 4])};
   }
+  return fr;
+}
+
+}  // namespace
+
+int32_t& TemplateRefiner::plan_node_slot(int32_t h, const TemplatePlanNode& n,
+                                         std::array<std::array<int8_t, 3>, 6>& frame) {
+  const HexCell& input = mesh_.hexes[h];
+  if (n.kind == TemplateNodeKey::edge) {
+    const int le = n.local;
+    const int32_t e = topology_.hex_edge_ids[h][le];
+    const int axis = hex_edge_axis[le];
+    int t6 = hex_corner[hex_edges[le][0]][axis] ? 6 - n.p6[axis] : n.p6[axis];
+    if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t6 = 6 - t6;
+    return edge_slot_[3 * static_cast<size_t>(e) + t6 - 2];
+  }
+  const int lf = n.local;
+  const auto& fr = face_frame(input, lf, frame);
+  const int* o = hex_corner[fr[0]];
+  const int* c1 = hex_corner[fr[1]];
+  const int* c3 = hex_corner[fr[2]];
+  int u6 = 0, v6 = 0;
+  for (int k = 0; k < 3; ++k) {
+    u6 += (c1[k] - o[k]) * (n.p6[k] - 6 * o[k]);
+    v6 += (c3[k] - o[k]) * (n.p6[k] - 6 * o[k]);
+  }
+  int32_t& base = face_base_[topology_.hex_face_ids[h][lf]];
+  if (base < 0) {
+    base = static_cast<int32_t>(face_slot_.size());
+    face_slot_.resize(face_slot_.size() + 9, -1);
+  }
+  return face_slot_[base + 3 * (u6 - 2) + (v6 - 2)];
+}
+
+TemplateNodeKey TemplateRefiner::plan_node_key(int32_t h, const TemplatePlanNode& n,
+                                               std::array<std::array<int8_t, 3>, 6>& frame) const {
+  const HexCell& input = mesh_.hexes[h];
+  if (n.kind == TemplateNodeKey::edge) {
+    const int le = n.local;
+    const int32_t e = topology_.hex_edge_ids[h][le];
+    const int axis = hex_edge_axis[le];
+    int64_t t = hex_corner[hex_edges[le][0]][axis] ? kUnit - n.param[axis] : n.param[axis];
+    if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t = kUnit - t;
+    return make_key(TemplateNodeKey::edge, e, t);
+  }
+  const int lf = n.local;
+  const auto& fr = face_frame(input, lf, frame);
   const int* o = hex_corner[fr[0]];
   const int* c1 = hex_corner[fr[1]];
   const int* c3 = hex_corner[fr[2]];
@@ -661,8 +709,8 @@ void TemplateRefiner::apply_whole_batch(std::span<const TemplateApplication> app
         ++next;
         continue;
       }
-      int32_t* s = slot_of(plan_node_key(apps[i].hex, n, frame));
-      if (*s < 0) *s = next++;
+      int32_t& s = plan_node_slot(apps[i].hex, n, frame);
+      if (s < 0) s = next++;
     }
   }
   first_new[apps.size()] = next;
@@ -694,8 +742,7 @@ void TemplateRefiner::apply_whole_batch(std::span<const TemplateApplication> app
                          n.param[2]);
           id = own++;
         } else {
-          key = plan_node_key(h, n, fr);
-          id = *slot_of(key);
+          id = plan_node_slot(h, n, fr);  // every slot was claimed (and allocated) above
           if (id < first_new[i]) {
             ids[j] = id;
             continue;
@@ -706,7 +753,9 @@ void TemplateRefiner::apply_whole_batch(std::span<const TemplateApplication> app
         Eigen::Vector3d p = Eigen::Vector3d::Zero();
         for (int v = 0; v < 8; ++v) p += n.weight[v] * x[v];
         points_[id] = p;
-        if (record_keys_) created_keys_[id - mesh_.points.size()] = key;
+        if (record_keys_)
+          created_keys_[id - mesh_.points.size()] =
+              n.kind == TemplateNodeKey::interior ? key : plan_node_key(h, n, fr);
       }
       HexCell* out = children.data() + child_offset[i];
       for (const auto& c : plan.children) {
@@ -740,6 +789,7 @@ void template_compile(HexTemplate& t) {
         const int64_t q = std::llround(scaled);
         on_grid = on_grid && std::abs(scaled - double(q)) < 1e-3 && q >= 0 && q <= kUnit;
         n.param[k] = q;
+        n.p6[k] = static_cast<int8_t>(q % (kUnit / 6) == 0 ? q / (kUnit / 6) : -1);
         if (q == 0 || q == kUnit) {
           ++extreme;
           fixed_axis = k;

@@ -56,6 +56,7 @@ struct TemplatePlanNode {
   int8_t kind = -1;
   int8_t local = -1;               ///< local vertex, edge or face of the hex (by kind)
   std::array<int64_t, 3> param{};  ///< exact position in the hex's cube (template_param_unit)
+  std::array<int8_t, 3> p6{};      ///< the same in sixths, where it is a multiple of 1/6
   std::array<double, 8> weight{};  ///< trilinear weights of the hex corners at that position
 };
 
@@ -300,6 +301,10 @@ class TemplateRefiner {
   };
   std::vector<Placed> placed_;       ///< scratch of apply()
   std::vector<int32_t> placed_ids_;  ///< scratch of apply_whole()
+  /// Slot of a compiled edge or face node of a whole hex of a slotted plan, computed from its
+  /// sixths without building the key (same slot as slot_of(plan_node_key(...))).
+  int32_t& plan_node_slot(int32_t hex, const TemplatePlanNode& n,
+                          std::array<std::array<int8_t, 3>, 6>& frame);
   /// Key of a compiled edge or face node of a whole hex (kind edge or face only).
   TemplateNodeKey plan_node_key(int32_t hex, const TemplatePlanNode& n,
                                 std::array<std::array<int8_t, 3>, 6>& frame) const;

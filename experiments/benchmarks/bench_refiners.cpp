@@ -10,8 +10,8 @@
 /// second), `output_MB`, `floor_s` and `floor_ratio` (the time to write the output's bytes into
 /// fresh memory in the same run, and our median time over it) and `peak_rss_MB` (the benchmark's
 /// peak resident memory, VmHWM, reset at its start). Sizes: 10, 25, 50; 10 only under
-/// HEXREFINE_BENCH_SMOKE=1 (`hexrefine bench --smoke`); 75 (the thesis' largest brick: about 6 GB,
-/// tens of seconds) only under HEXREFINE_BENCH_LARGE=1. A refiner that throws (e.g. not implemented
+/// HEXREFINE_BENCH_SMOKE=1 (`hexrefine bench --smoke`); 75 (the thesis' largest brick: up to 3 GB,
+/// 1 to 6 s a run) only under HEXREFINE_BENCH_LARGE=1. A refiner that throws (e.g. not implemented
 /// yet) is reported as a skipped benchmark with its message.
 ///
 /// Run (Release): bench_refiners --benchmark_repetitions=3

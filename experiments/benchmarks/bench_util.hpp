@@ -6,8 +6,8 @@
 /// Environment:
 /// - HEXREFINE_BENCH_SMOKE=1 (set by `hexrefine bench --smoke`): only the smallest size of each
 ///   family is registered, so the whole suite runs in seconds.
-/// - HEXREFINE_BENCH_LARGE=1: adds the thesis' 75^3 brick (about 6 GB and tens of seconds for
-///   the refiners).
+/// - HEXREFINE_BENCH_LARGE=1: adds the thesis' 75^3 brick (up to 3 GB and 1 to 6 s per refiner
+///   run).
 /// - HEXREFINE_SHARED_DIR: the shared/ folder (default: ../../../shared from the executable,
 ///   i.e. beside the source tree when the build folder is <source>/build).
 

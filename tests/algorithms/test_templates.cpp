@@ -372,18 +372,25 @@ TEST(TemplateRefiner, CompiledApplicationMatchesTheGenericOne) {
   int compared = 0;
   for (const HexTemplate* t : all) {
     for (int sym = 0; sym < 48; sym += 5) {
-      TemplateRefiner generic(m, topo), compiled(m, topo);
-      std::vector<HexCell> a, b;
+      TemplateRefiner generic(m, topo), compiled(m, topo), direct(m, topo);
+      direct.set_record_keys(false);  // the path straight to the slots, without keys
+      std::vector<HexCell> a, b, c;
       for (int32_t h = 0; h < m.hex_count(); h += 2) {
         std::vector<TemplateCell> cells;
         generic.apply(generic.cell_whole(h), *t, sym, cells);
-        for (const TemplateCell& c : cells) a.push_back(c.nodes);
+        for (const TemplateCell& cell : cells) a.push_back(cell.nodes);
         compiled.apply_whole(h, *t, sym, false, b);
+        direct.apply_whole(h, *t, sym, false, c);
       }
       ASSERT_EQ(a, b) << template_tag_name(t->tag) << " symmetry " << sym;
+      ASSERT_EQ(a, c) << template_tag_name(t->tag) << " symmetry " << sym;
       ASSERT_EQ(generic.points().size(), compiled.points().size());
-      for (size_t i = 0; i < generic.points().size(); ++i)
+      ASSERT_EQ(generic.points().size(), direct.points().size());
+      for (size_t i = 0; i < generic.points().size(); ++i) {
         ASSERT_EQ(generic.points()[i], compiled.points()[i]);
+        ASSERT_EQ(generic.points()[i], direct.points()[i]);
+      }
+      EXPECT_TRUE(direct.created_keys().empty());
       ASSERT_EQ(generic.created_keys(), compiled.created_keys());
       ++compared;
     }

@@ -9,13 +9,6 @@
 namespace hexrefine {
 namespace {
 
-std::string file_text(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(CliRefineThreads, SameFileForAnyThreadCount) {
   const auto dir = test_temp_dir("cli_refine_threads");
   const std::string brick = (dir / "brick.mesh").string();
@@ -29,7 +22,7 @@ TEST(CliRefineThreads, SameFileForAnyThreadCount) {
         const CliRun r = cli_run("refine " + brick + " " + out + " --method " + method +
                                  " --select " + select + " --threads " + std::to_string(threads));
         ASSERT_EQ(r.exit_code, 0) << method << " " << select << " " << threads << ": " << r.output;
-        const std::string text = file_text(out);
+        const std::string text = test_file_text(out);
         ASSERT_GT(text.size(), 1000u);
         if (first.empty())
           first = text;

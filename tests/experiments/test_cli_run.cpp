@@ -57,10 +57,7 @@ TEST(CliRun, ResumeOfAFinishedRunRunsNothing) {
   const CliRun r = cli_run("run " + (dir / "c.json").string() + " --resume");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("0 records written (2 already present"), std::string::npos) << r.output;
-  std::ifstream in(dir / "out" / "a.jsonl");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  EXPECT_EQ(ss.str(), done);
+  EXPECT_EQ(test_file_text(dir / "out" / "a.jsonl"), done);
 }
 
 TEST(CliReproduce, RefusesStrayArguments) {
@@ -107,13 +104,6 @@ TEST(CliMerge, JoinsShardsDeduplicatedInCaseOrder) {
 namespace hexrefine {
 namespace {
 
-std::string file_read(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 TEST(CliRun, RunsBothMethodsOnTheSameTargetsAndChecksTheOutputs) {
   const auto dir = test_temp_dir("cli_run_real");
   const std::string abaqus = shared_mesh("abaqus_hex_2x2x2.inp");
@@ -150,7 +140,7 @@ TEST(CliRun, RunsBothMethodsOnTheSameTargetsAndChecksTheOutputs) {
   }
   const json& inp = c.records[2];
   EXPECT_EQ(inp["final_hexes"], 216);
-  EXPECT_EQ(inp["input"]["sha256"], sha256_hex(file_read(abaqus)));
+  EXPECT_EQ(inp["input"]["sha256"], sha256_hex(test_file_text(abaqus)));
   EXPECT_EQ(inp["conformal"], true);
   const json& bad = c.records[3];
   EXPECT_EQ(bad["error_kind"], "input");
@@ -193,10 +183,7 @@ TEST(PlotsPy, PutsOursBesideTheThesisWithRatios) {
   const CliRun r = plots_py((dir / "r.jsonl").string() + " --thesis " + thesis + " --out " +
                             (dir / "out").string() + " --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::ifstream in(dir / "out" / "tables.md");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string md = ss.str();
+  const std::string md = test_file_text(dir / "out" / "tables.md");
   // Thesis G-1: sheet 27,000 hexes in 6.484 s, selective 8,060 in 0.797 s (ratios ours/thesis).
   EXPECT_NE(md.find("| Final element count | 27,000 | 27,000 | 1 | 8,060 | 8,060 | 1 |"),
             std::string::npos)

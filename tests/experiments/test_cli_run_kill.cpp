@@ -29,10 +29,7 @@ namespace fs = std::filesystem;
 
 /// Complete lines of `p` (a killed writer may leave a partial last line without '\n').
 std::vector<std::string> file_complete_lines(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
+  const std::string text = test_file_text(p);
   std::vector<std::string> lines;
   size_t start = 0;
   for (size_t nl = text.find('\n'); nl != std::string::npos; nl = text.find('\n', start)) {

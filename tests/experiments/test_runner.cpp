@@ -17,13 +17,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-std::string file_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 void file_put(const fs::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary | std::ios::trunc);
   out << text;
@@ -230,7 +223,7 @@ TEST(Jsonl, AppendsAndReadsBack) {
   ASSERT_EQ(c.records.size(), 3u);
   EXPECT_EQ(c.records[2]["value"], 2);
   EXPECT_FALSE(c.truncated_tail);
-  EXPECT_EQ(c.valid_text, file_text(path));
+  EXPECT_EQ(c.valid_text, test_file_text(path));
   EXPECT_EQ(std::count(c.valid_text.begin(), c.valid_text.end(), '\n'), 3);
 }
 
@@ -310,7 +303,7 @@ TEST(RunPlanExecute, ResumeAfterKilledRunLosesNothingAndRepeatsNothing) {
   FakeExecutor first;
   run_plan_execute(plan, quiet_settings(), std::ref(first));
   // Simulate a run killed while writing its 6th record: 5 whole lines and half of the 6th.
-  std::string text = file_text(out);
+  std::string text = test_file_text(out);
   size_t pos = 0;
   for (int i = 0; i < 5; ++i) pos = text.find('\n', pos) + 1;
   const size_t sixth_end = text.find('\n', pos);

@@ -22,13 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string file_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 int folder_entries(const fs::path& dir) {
   int n = 0;
   for (const auto& e : fs::directory_iterator(dir)) n += static_cast<int>(!e.path().empty());
@@ -39,7 +32,7 @@ TEST(AtomicFile, GoodFileSurvivesAWriterThatThrowsMidway) {
   const auto dir = test_temp_dir("atomic_throw");
   const fs::path p = dir / "report.json";
   file_write_atomically(p.string(), [](std::ostream& os) { os << "{\"good\": true}\n"; });
-  ASSERT_EQ(file_text(p), "{\"good\": true}\n");
+  ASSERT_EQ(test_file_text(p), "{\"good\": true}\n");
   // A writer that has already written 1 MB when it fails: the failure propagates unchanged.
   EXPECT_THROW(file_write_atomically(p.string(),
                                      [](std::ostream& os) {
@@ -48,7 +41,7 @@ TEST(AtomicFile, GoodFileSurvivesAWriterThatThrowsMidway) {
                                        throw std::runtime_error("writer failed");
                                      }),
                std::runtime_error);
-  EXPECT_EQ(file_text(p), "{\"good\": true}\n");
+  EXPECT_EQ(test_file_text(p), "{\"good\": true}\n");
   EXPECT_EQ(folder_entries(dir), 1);  // no temporary file left
 }
 
@@ -57,13 +50,13 @@ TEST(AtomicFile, GoodMeshSurvivesAFailedMeshWrite) {
   for (const char* name : {"m.mesh", "m.vtk", "m.vtu", "m.msh", "m.e", "m.inp"}) {
     const fs::path p = dir / name;
     mesh_write(p.string(), fixture_brick(2, 1, 1));
-    const std::string good = file_text(p);
+    const std::string good = test_file_text(p);
     ASSERT_FALSE(good.empty());
     // A mesh the writer refuses (a hex names node 99 of 12): InputError, the old file stays.
     HexMesh bad = fixture_brick(2, 1, 1);
     bad.hexes[1][3] = 99;
     EXPECT_THROW(mesh_write(p.string(), bad), InputError) << name;
-    EXPECT_EQ(file_text(p), good) << name;
+    EXPECT_EQ(test_file_text(p), good) << name;
     EXPECT_EQ(mesh_read(p.string()).hex_count(), 2) << name;
   }
   EXPECT_EQ(folder_entries(dir), 6);
@@ -74,7 +67,7 @@ TEST(AtomicFile, SuccessfulWriteReplacesTheWholeFile) {
   const fs::path p = dir / "a.txt";
   file_write_atomically(p.string(), [](std::ostream& os) { os << std::string(5000, 'a'); });
   file_write_atomically(p.string(), [](std::ostream& os) { os << "short\n"; });
-  EXPECT_EQ(file_text(p), "short\n");
+  EXPECT_EQ(test_file_text(p), "short\n");
   EXPECT_EQ(folder_entries(dir), 1);
 }
 

@@ -101,13 +101,6 @@ INSTANTIATE_TEST_SUITE_P(
                       ExactCase{"exodus", "a.e", false}),
     [](const auto& info) { return std::string(info.param.name); });
 
-std::string file_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 TEST(IoExactText, MeditPrintsTheShortestRoundTripForm) {
   const auto dir = test_temp_dir("io_exact_shortest");
   HexMesh m = fixture_brick(1, 1, 1);
@@ -116,7 +109,7 @@ TEST(IoExactText, MeditPrintsTheShortestRoundTripForm) {
   m.points[2] = {1.0, -2.5, 1e23};
   const std::string path = (dir / "one.mesh").string();
   mesh_write(path, m);
-  const std::string text = file_text(path);
+  const std::string text = test_file_text(path);
   const std::string expected_head =
       "MeshVersionFormatted 2\nDimension 3\nVertices\n8\n"
       "0.1 0.3333333333333333 -0 0\n"

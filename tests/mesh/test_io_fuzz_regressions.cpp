@@ -23,13 +23,6 @@
 namespace hexrefine {
 namespace {
 
-std::string file_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 /// The InputError message of reading `bytes` as `name`; fails the test if the bytes are accepted
 /// or end in any other exception.
 std::string refusal_of(const std::string& name, const std::string& bytes) {
@@ -51,7 +44,7 @@ TEST(IoFuzzRegressions, MemoryReaderMatchesFileReaderInEveryFormat) {
     const std::string p = (dir / name).string();
     mesh_write(p, m);
     const HexMesh from_file = mesh_read(p);
-    const HexMesh from_memory = mesh_read_from_memory(name, file_bytes(p));
+    const HexMesh from_memory = mesh_read_from_memory(name, test_file_text(p));
     SCOPED_TRACE(name);
     EXPECT_EQ(from_memory.hex_count(), 12);
     io_expect_same_geometry(from_file, from_memory, 0.0);
@@ -158,7 +151,7 @@ TEST(IoFuzzRegressions, ExodusHeaderClaimingHugeCountsIsRefused) {
   const auto dir = test_temp_dir("io_fuzz_exodus");
   const std::string p = (dir / "b.e").string();
   mesh_write(p, fixture_brick(1, 1, 1));
-  const std::string good = file_bytes(p);
+  const std::string good = test_file_text(p);
   ASSERT_EQ(mesh_read_from_memory("b.e", good).hex_count(), 1);
   // netCDF classic header: a dimension is its name (padded to 4 bytes) and a 32-bit big-endian
   // length. Set num_nodes / num_elem to 2^31 - 1 (the largest the format holds).
@@ -190,7 +183,7 @@ TEST(IoFuzzRegressions, EveryCommittedFuzzFindingIsRefused) {
   for (const auto& f : files) {
     SCOPED_TRACE(f.string());
     EXPECT_THROW(mesh_read(f.string()), InputError);
-    const std::string msg = refusal_of(f.filename().string(), file_bytes(f.string()));
+    const std::string msg = refusal_of(f.filename().string(), test_file_text(f.string()));
     EXPECT_FALSE(msg.empty());
   }
 }

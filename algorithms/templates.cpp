@@ -855,6 +855,7 @@ TemplateApplyResult templates_apply(const HexMesh& mesh, const HexTopology& topo
     application_of[h] = static_cast<int32_t>(i);
   }
   TemplateRefiner refiner(mesh, topology);
+  refiner.set_record_keys(false);  // the keys stay inside: nobody reads them
   for (const TemplateFaceAlias& al : aliases)
     for (int k = 0; k < 2; ++k)
       refiner.alias(make_key(TemplateNodeKey::face, al.face, al.face_positions[k][0] * kUnit / 6,

@@ -136,8 +136,11 @@ int cli_refine(const std::vector<std::string>& args) {
       throw InputError(in + ": " + std::to_string(inverted) + " inverted hexes, first at id " +
                        std::to_string(first) + " (use --allow-inverted to refine anyway)");
   }
-  const HexTopology topology = topology_build(input);
-  const Selection selection = select_hexes(input, topology, specs);
+  // The input's topology is needed for the selection only: gone before the refinement.
+  const Selection selection = [&] {
+    const HexTopology topology = topology_build(input);
+    return select_hexes(input, topology, specs);
+  }();
 
   RefineResult result;
   if (selection.hexes.empty()) {

@@ -292,7 +292,17 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
   MeshCheckReport r;
   r.hexes = mesh.hex_count();
   r.nodes = mesh.point_count();
-  const HexTopology t = topology_build(mesh);
+  // Unused and duplicate nodes first: their work arrays are gone before the topology is built.
+  {
+    std::vector<char> used(mesh.points.size(), 0);
+    for (const HexCell& c : mesh.hexes)
+      for (int32_t v : c) used[v] = 1;
+    r.unused_nodes = std::count(used.begin(), used.end(), 0);
+  }
+  r.duplicate_nodes = count_duplicate_nodes(mesh);
+  // Faces only: the check needs no edge table (boundary edges are counted below from the
+  // boundary faces alone), which keeps the memory of checking a large output down.
+  const HexTopology t = topology_build(mesh, TopologyParts::faces);
   r.nonmanifold_faces = static_cast<int64_t>(t.nonmanifold_faces.size());
 
   // Quality and volume.
@@ -324,30 +334,34 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
     }
   }
 
-  // Unused nodes.
-  std::vector<char> used(mesh.points.size(), 0);
-  for (const HexCell& c : mesh.hexes)
-    for (int32_t v : c) used[v] = 1;
-  r.unused_nodes = std::count(used.begin(), used.end(), 0);
-  r.duplicate_nodes = count_duplicate_nodes(mesh);
-
   // Boundary surface: closedness and area.
   const BoundarySurface surface = boundary_surface(mesh, t);
   r.boundary_faces = static_cast<int64_t>(surface.faces.size());
-  std::vector<int32_t> edge_uses(t.edge_count(), 0);
+  // Every boundary edge must be used by exactly two boundary faces: count the uses of each
+  // (lower node, higher node) pair over the boundary faces (sorted, linear in the boundary).
+  std::vector<uint64_t> boundary_edges;
+  boundary_edges.reserve(4 * surface.faces.size());
   for (size_t i = 0; i < surface.faces.size(); ++i) {
-    const int32_t f = surface.faces[i];
-    const int32_t h = t.face_hexes[f][0];
-    for (int le : hex_face_edges[t.face_local[f][0]]) ++edge_uses[t.hex_edge_ids[h][le]];
+    const auto& n = surface.nodes[i];
+    for (int k = 0; k < 4; ++k) {
+      const uint32_t a = static_cast<uint32_t>(n[k]), b = static_cast<uint32_t>(n[(k + 1) % 4]);
+      boundary_edges.push_back(static_cast<uint64_t>(std::min(a, b)) << 32 | std::max(a, b));
+    }
     r.boundary_area += quad_area(surface.quads[i]);
   }
-  for (int32_t uses : edge_uses) r.nonmanifold_boundary_edges += (uses != 0 && uses != 2);
+  std::sort(boundary_edges.begin(), boundary_edges.end());
+  for (size_t i = 0; i < boundary_edges.size();) {
+    size_t j = i;
+    while (j < boundary_edges.size() && boundary_edges[j] == boundary_edges[i]) ++j;
+    r.nonmanifold_boundary_edges += (j - i != 2);
+    i = j;
+  }
 
   // Non-conformal faces: boundary faces off the reference surface, or (without a reference)
   // lying on another boundary face of this mesh.
   std::vector<int32_t> non_conformal;  // indices into surface
   if (reference) {
-    const HexTopology reference_topology = topology_build(*reference);
+    const HexTopology reference_topology = topology_build(*reference, TopologyParts::faces);
     const BoundarySurface reference_surface = boundary_surface(*reference, reference_topology);
     const QuadGrid grid(reference_surface.quads, reference_surface.tolerances);
     for (size_t i = 0; i < surface.quads.size(); ++i) {

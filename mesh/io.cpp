@@ -89,7 +89,7 @@ std::vector<int32_t> id_permutation_slots(const std::vector<int64_t>& ids) {
 
 void mesh_check_read(const HexMesh& mesh, const std::string& path) {
   mesh_validate_ids(mesh, path);
-  const HexTopology t = topology_build(mesh);
+  const HexTopology t = topology_build(mesh, TopologyParts::faces);
   if (!t.nonmanifold_faces.empty()) {
     const auto& f = t.face_nodes[t.nonmanifold_faces[0]];
     throw InputError(path + ": non-manifold mesh: face with nodes " + std::to_string(f[0]) + " " +

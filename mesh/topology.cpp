@@ -40,7 +40,8 @@ constexpr std::array<std::array<int, 3>, 8> vertex_faces = make_vertex_faces();
 
 }  // namespace
 
-HexTopology topology_build(const HexMesh& mesh) {
+HexTopology topology_build(const HexMesh& mesh, TopologyParts parts) {
+  const bool edges = parts == TopologyParts::all;
   HexTopology t;
   const int32_t nh = mesh.hex_count();
   t.node_count = mesh.point_count();
@@ -49,12 +50,12 @@ HexTopology topology_build(const HexMesh& mesh) {
       t.node_hexes, 8, nullptr);
 
   // Edges and faces are grouped at their lowest node: every node looks only at its own hexes.
-  t.hex_edge_ids.assign(nh, {});
+  if (edges) t.hex_edge_ids.assign(nh, {});
   t.hex_face_ids.assign(nh, {});
   // About 3 edges and 3 faces per hex plus the boundary's share; 3.25 per hex covers bricks of
   // 25^3 and more without a reallocation (a 100^3 brick has 3.03 M edges and faces).
   const size_t expected = static_cast<size_t>(nh) * 13 / 4 + 1024;
-  t.edge_nodes.reserve(expected);
+  if (edges) t.edge_nodes.reserve(expected);
   t.face_nodes.reserve(expected);
   t.face_hexes.reserve(expected);
   t.face_local.reserve(expected);
@@ -76,6 +77,7 @@ HexTopology topology_build(const HexMesh& mesh) {
       int i = 0;
       while (c[i] != a) ++i;
       for (int le : hex_vertex_edges[i]) {
+        if (!edges) break;
         const int32_t b = c[hex_edges[le][0]] == a ? c[hex_edges[le][1]] : c[hex_edges[le][0]];
         if (b < a) continue;
         int32_t id = -1;
@@ -128,9 +130,16 @@ HexTopology topology_build(const HexMesh& mesh) {
   }
   std::sort(t.nonmanifold_faces.begin(), t.nonmanifold_faces.end());
 
-  build_csr(
-      t.edge_count(), nh, [&](int64_t h, int k) { return t.hex_edge_ids[h][k]; },
-      t.edge_hex_offsets, t.edge_hexes, 12, nullptr);
+  if (!edges) {
+    // Only the grouping needed node -> hexes here; its memory goes back before the caller's
+    // next allocations.
+    std::vector<int32_t>().swap(t.node_hexes);
+    std::vector<int32_t>().swap(t.node_hex_offsets);
+  }
+  if (edges)
+    build_csr(
+        t.edge_count(), nh, [&](int64_t h, int k) { return t.hex_edge_ids[h][k]; },
+        t.edge_hex_offsets, t.edge_hexes, 12, nullptr);
   return t;
 }
 

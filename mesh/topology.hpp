@@ -40,9 +40,18 @@ struct HexTopology {
   int32_t face_count() const { return static_cast<int32_t>(face_nodes.size()); }
 };
 
+/// Which parts topology_build fills.
+enum class TopologyParts : uint8_t {
+  all,    ///< everything
+  faces,  ///< the faces only (face_*, hex_face_ids, nonmanifold_faces): edges and node ->
+          ///< hexes stay empty (about half the memory)
+};
+
 /// Builds the topology in O(n) time (node-centric grouping, no global sort, no node-pair map).
-/// Precondition: mesh_validate_ids(mesh) holds.
-HexTopology topology_build(const HexMesh& mesh);
+/// Precondition: mesh_validate_ids(mesh) holds. With TopologyParts::faces, functions that need
+/// edges or node -> hexes (node_hexes, edge_hexes, edge_is_boundary, edge_face_count,
+/// hex_local_edge) must not be called.
+HexTopology topology_build(const HexMesh& mesh, TopologyParts parts = TopologyParts::all);
 
 /// Hexes around node n.
 inline std::span<const int32_t> node_hexes(const HexTopology& t, int32_t n) {

@@ -58,7 +58,7 @@ HexTopology topology_build(const HexMesh& mesh, TopologyParts parts) {
   if (edges) t.edge_nodes.reserve(expected);
   t.face_nodes.reserve(expected);
   t.face_hexes.reserve(expected);
-  t.face_local.reserve(expected);
+  if (edges) t.face_local.reserve(expected);
   struct LocalEdge {
     int32_t other, id;
   };
@@ -112,7 +112,7 @@ HexTopology topology_build(const HexMesh& mesh, TopologyParts parts) {
           const int32_t id = static_cast<int32_t>(t.face_nodes.size());
           t.face_nodes.push_back(q);
           t.face_hexes.push_back({h, -1});
-          t.face_local.push_back({static_cast<int8_t>(lf), -1});
+          if (edges) t.face_local.push_back({static_cast<int8_t>(lf), -1});
           local_faces.push_back({others, id, 1});
           t.hex_face_ids[h][lf] = id;
           continue;
@@ -121,7 +121,7 @@ HexTopology topology_build(const HexMesh& mesh, TopologyParts parts) {
         t.hex_face_ids[h][lf] = id;
         if (++found->users == 2) {
           t.face_hexes[id][1] = h;
-          t.face_local[id][1] = static_cast<int8_t>(lf);
+          if (edges) t.face_local[id][1] = static_cast<int8_t>(lf);
         } else if (found->users == 3) {
           t.nonmanifold_faces.push_back(id);
         }

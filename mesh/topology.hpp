@@ -43,8 +43,8 @@ struct HexTopology {
 /// Which parts topology_build fills.
 enum class TopologyParts : uint8_t {
   all,    ///< everything
-  faces,  ///< the faces only (face_*, hex_face_ids, nonmanifold_faces): edges and node ->
-          ///< hexes stay empty (about half the memory)
+  faces,  ///< the faces only (face_nodes, face_hexes, hex_face_ids, nonmanifold_faces): edges,
+          ///< node -> hexes and face_local stay empty (about half the memory)
 };
 
 /// Builds the topology in O(n) time (node-centric grouping, no global sort, no node-pair map).

@@ -73,21 +73,6 @@ bool hex_is_inverted(const HexMesh& m, int32_t h) {
   return hex_scaled_jacobian(hex_points(m, h)) <= 0.0;
 }
 
-// True if the hex is a parallelepiped (its trilinear map is affine) up to rounding: every corner
-// is x0 + the combination of the three edge vectors at corner 0 that its reference position
-// gives, within 1e-9 of the longest of those edges.
-bool hex_is_affine(const HexMesh& m, int32_t h) {
-  const auto x = hex_points(m, h);
-  const Eigen::Vector3d a = x[1] - x[0], b = x[3] - x[0], c = x[4] - x[0];
-  const double tol = 1e-9 * std::max({a.norm(), b.norm(), c.norm()});
-  for (int v = 0; v < 8; ++v) {
-    const Eigen::Vector3d expected =
-        x[0] + hex_corner[v][0] * a + hex_corner[v][1] * b + hex_corner[v][2] * c;
-    if ((x[v] - expected).norm() > tol) return false;
-  }
-  return true;
-}
-
 enum Role : uint8_t { kUntouched = 0, kTarget = 1, kElement = 2, kDirectional = 3 };
 
 // Local edges an element-by-element template or a directional step would adjust at, for a hex
@@ -782,7 +767,8 @@ void SelectivePass::check_output(const PassOutput& out) const {
   std::vector<int32_t> bad_parents, inverted_parents;
   if (any_risky) check_region(out, in_region, bad_parents);
   std::vector<uint8_t> affine(nh, 0);
-  for (int32_t h = 0; h < nh; ++h) affine[h] = !in_region[h] && hex_is_affine(mesh_, h);
+  for (int32_t h = 0; h < nh; ++h)
+    affine[h] = !in_region[h] && hex_is_parallelepiped(hex_points(mesh_, h));
   for (int32_t h = 0; h < out.mesh.hex_count(); ++h) {
     if (out.role[out.parent[h]] == kUntouched || affine[out.parent[h]]) continue;
     if (options_.allow_inverted && hex_is_inverted(mesh_, out.parent[h])) continue;
@@ -969,7 +955,6 @@ PassOutput SelectivePass::run() {
     res.hexes.resize(out_hexes);
   else
     res.hexes.reserve(out_hexes);
-  out.parent.reserve(out_hexes);
   size_t at = 0;
   auto put = [&](const HexCell& c) {
     if (parallel)

@@ -72,6 +72,7 @@
 #include "algorithms/templates.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
 
 namespace hexrefine {
 
@@ -565,7 +566,7 @@ void composite_face_hashes(SheetComposite& c) {
         uint64_t h = 0xCBF29CE484222325ull;
         for (const auto& q : quads)
           for (const auto& p : q) h = hash_mix(hash_mix(h, p[0]), p[1]);
-        c.face_hash[lf][2 * i0 + (step == 1 ? 0 : 1)] = h;
+        c.face_hash[lf][2 * i0 + (step == 1 ? 0 : 1)] = h | 1;  // never 0: 0 marks "not seen"
       }
   }
 }
@@ -617,19 +618,6 @@ int face_frame_index(const HexCell& hex, int lf) {
     if (hex[hex_faces[lf][c]] < hex[hex_faces[lf][i0]]) i0 = c;
   const bool step1 = hex[hex_faces[lf][(i0 + 1) % 4]] < hex[hex_faces[lf][(i0 + 3) % 4]];
   return 2 * i0 + (step1 ? 0 : 1);
-}
-
-// True if the hex is a parallelepiped up to rounding (its children are then affine images of
-// the composite's, whose orientation was checked once on the reference cube).
-bool hex_is_parallelepiped(const HexMesh& m, int32_t h) {
-  const auto x = hex_points(m, h);
-  const Eigen::Vector3d a = x[1] - x[0], b = x[3] - x[0], c = x[4] - x[0];
-  const double tol = 1e-9 * std::max({a.norm(), b.norm(), c.norm()});
-  for (int v = 0; v < 8; ++v)
-    if ((x[v] - (x[0] + hex_corner[v][0] * a + hex_corner[v][1] * b + hex_corner[v][2] * c))
-            .norm() > tol)
-      return false;
-  return true;
 }
 
 PassOutput refine_composites(const HexMesh& mesh, const HexTopology& topology,
@@ -705,7 +693,7 @@ PassOutput refine_composites(const HexMesh& mesh, const HexTopology& topology,
       if (!composite_of[i]->positive)
         throw OperationError("sheet refinement: the refinement of input hex " + std::to_string(h) +
                              " is inverted even on the reference cube");
-      check[h] = !hex_is_parallelepiped(mesh, h);
+      check[h] = !hex_is_parallelepiped(hex_points(mesh, h));
     }
     for (int32_t i = 0; i < applied.mesh.hex_count(); ++i)
       if (check[applied.parent[i]] && !hex_corners_positive(applied.mesh, i))

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <thread>
 
 #include "mesh/error.hpp"
@@ -333,7 +334,8 @@ int32_t* TemplateRefiner::slot_of(const TemplateNodeKey& key) {
 const TemplateNodeKey* TemplateRefiner::alias_of(const TemplateNodeKey& key) const {
   if (aliases_.empty()) return nullptr;
   if (key.kind() == TemplateNodeKey::face) {
-    if (!face_aliased_[key.entity & 0xFFFFFFFFFF]) return nullptr;
+    // Empty while every alias so far starts from a non-face key.
+    if (face_aliased_.empty() || !face_aliased_[key.entity & 0xFFFFFFFFFF]) return nullptr;
   } else if (other_aliases_ == 0) {
     return nullptr;
   }
@@ -765,11 +767,21 @@ void TemplateRefiner::apply_whole_batch(std::span<const TemplateApplication> app
     }
   };
   const size_t parts = std::min<size_t>(static_cast<size_t>(threads), apps.size());
+  // An exception in a worker (only std::bad_alloc can arise) is rethrown here, after the join.
+  std::vector<std::exception_ptr> failure(parts);
+  auto guarded = [&](size_t p) {
+    try {
+      run(apps.size() * p / parts, apps.size() * (p + 1) / parts);
+    } catch (...) {
+      failure[p] = std::current_exception();
+    }
+  };
   std::vector<std::thread> workers;
-  for (size_t p = 1; p < parts; ++p)
-    workers.emplace_back(run, apps.size() * p / parts, apps.size() * (p + 1) / parts);
-  run(0, apps.size() / parts);
+  for (size_t p = 1; p < parts; ++p) workers.emplace_back(guarded, p);
+  guarded(0);
   for (std::thread& w : workers) w.join();
+  for (const std::exception_ptr& e : failure)
+    if (e) std::rethrow_exception(e);
 }
 
 void template_compile(HexTemplate& t) {

@@ -127,4 +127,15 @@ double mesh_min_scaled_jacobian(const HexMesh& mesh) {
   return best;
 }
 
+bool hex_is_parallelepiped(const HexCorners& p) {
+  const Eigen::Vector3d a = p[1] - p[0], b = p[3] - p[0], c = p[4] - p[0];
+  const double tolerance = 1e-9 * std::max({a.norm(), b.norm(), c.norm()});
+  for (int v = 0; v < 8; ++v) {
+    const Eigen::Vector3d affine =
+        p[0] + hex_corner[v][0] * a + hex_corner[v][1] * b + hex_corner[v][2] * c;
+    if ((p[v] - affine).norm() > tolerance) return false;
+  }
+  return a.dot(b.cross(c)) > 0;
+}
+
 }  // namespace hexrefine

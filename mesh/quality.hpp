@@ -63,6 +63,14 @@ double hex_edge_ratio(const HexCorners& p);
 /// the polyhedron's volume when all faces are planar.
 double hex_volume(const HexCorners& p);
 
+/// True if the hex is a positively oriented parallelepiped up to rounding: its trilinear map is
+/// affine (every corner is p0 + the combination of the edge vectors a = p1 - p0, b = p3 - p0,
+/// c = p4 - p0 its reference position gives, within 1e-9 of the longest of them) and
+/// det(a, b, c) > 0. Then any sub-hex made by a template is the affine image of the template's
+/// child in the reference cube, with the same orientation. Unit cube: true; a mirrored cube or
+/// any hex with a bent face: false.
+bool hex_is_parallelepiped(const HexCorners& p);
+
 /// hex_scaled_jacobian of every hex, indexed by hex id. Precondition: mesh_validate_ids holds.
 std::vector<double> mesh_scaled_jacobians(const HexMesh& mesh);
 

@@ -683,6 +683,21 @@ TEST(SheetRefine, CompositesGiveTheRoundByRoundMesh) {
   EXPECT_GT(compared, 60);
 }
 
+TEST(SheetRefine, InvertedInputIsRefusedByBothPaths) {
+  // sheet_refine does not screen its input (the CLI does): an inside-out hex must still not
+  // come out as inverted children, whether the rounds run as composites or one by one.
+  HexMesh m = fixture_brick(2, 1, 1);
+  for (int v = 0; v < 4; ++v) std::swap(m.hexes[1][v], m.hexes[1][v + 4]);
+  Targets all{{0, 1}};
+  EXPECT_THROW(sheet_refine(m, all, {}), OperationError);
+  SheetControl rounds;
+  rounds.composites = false;
+  EXPECT_THROW(sheet_refine(m, all, {}, rounds), OperationError);
+  RefineOptions allow;
+  allow.allow_inverted = true;
+  EXPECT_EQ(sheet_refine(m, all, allow).mesh.hex_count(), 54);
+}
+
 // Runs the selective refiner, or skips while it is not implemented on this branch.
 #define SELECTIVE_OR_SKIP(result, ...)                                             \
   RefineResult result;                                                             \

@@ -77,6 +77,27 @@ TEST(Quality, InsideOutCube) {
   EXPECT_DOUBLE_EQ(hex_edge_ratio(p), 1.0);
 }
 
+TEST(Quality, ParallelepipedIsAffineAndPositive) {
+  EXPECT_TRUE(hex_is_parallelepiped(unit_cube()));
+  // Sheared and scaled: still affine.
+  HexCorners sheared = unit_cube();
+  for (Eigen::Vector3d& x : sheared)
+    x = Eigen::Vector3d(3 * x[0] + 0.5 * x[2], x[1] - 0.2 * x[0], 2 * x[2]);
+  EXPECT_TRUE(hex_is_parallelepiped(sheared));
+  // Inside out: affine but negatively oriented.
+  HexCorners mirrored = unit_cube();
+  for (int v = 0; v < 4; ++v) std::swap(mirrored[v], mirrored[v + 4]);
+  EXPECT_FALSE(hex_is_parallelepiped(mirrored));
+  // One corner moved by 1e-6 of the size: no longer affine; by 1e-12: rounding, still affine.
+  HexCorners bent = unit_cube();
+  bent[6] += Eigen::Vector3d(0, 0, 1e-6);
+  EXPECT_FALSE(hex_is_parallelepiped(bent));
+  HexCorners rounded = unit_cube();
+  rounded[6] += Eigen::Vector3d(0, 0, 1e-12);
+  EXPECT_TRUE(hex_is_parallelepiped(rounded));
+  EXPECT_FALSE(hex_is_parallelepiped(verdict_reference_hex()));
+}
+
 TEST(Quality, VolumeOfNonPlanarHexIsExactTrilinearIntegral) {
   // Lifting one top corner by d adds the volume under the bilinear patch: d/4.
   HexCorners p = unit_cube();

@@ -619,59 +619,61 @@ const std::array<int8_t, 3>& face_frame(const HexCell& input, int lf,
   return fr;
 }
 
+// Position (in `unit`s of the edge) of a point whose coordinate along local edge le's axis is
+// `along`, measured in the edge's global direction (from its lower node id).
+int64_t edge_position(const HexCell& input, const std::array<int32_t, 2>& edge_nodes, int le,
+                      int64_t along, int64_t unit) {
+  int64_t t = hex_corner[hex_edges[le][0]][hex_edge_axis[le]] ? unit - along : along;
+  if (input[hex_edges[le][0]] != edge_nodes[0]) t = unit - t;
+  return t;
+}
+
+// Coordinates (u, v) (in `unit`s of the face) of point p (in `unit`s of the hex) in a face frame.
+template <class Point>
+std::array<int64_t, 2> face_position(const std::array<int8_t, 3>& fr, const Point& p,
+                                     int64_t unit) {
+  const int* o = hex_corner[fr[0]];
+  const int* c1 = hex_corner[fr[1]];
+  const int* c3 = hex_corner[fr[2]];
+  std::array<int64_t, 2> uv{0, 0};
+  for (int k = 0; k < 3; ++k) {
+    uv[0] += (c1[k] - o[k]) * (p[k] - o[k] * unit);
+    uv[1] += (c3[k] - o[k]) * (p[k] - o[k] * unit);
+  }
+  return uv;
+}
+
 }  // namespace
 
 int32_t& TemplateRefiner::plan_node_slot(int32_t h, const TemplatePlanNode& n,
                                          std::array<std::array<int8_t, 3>, 6>& frame) {
   const HexCell& input = mesh_.hexes[h];
   if (n.kind == TemplateNodeKey::edge) {
-    const int le = n.local;
-    const int32_t e = topology_.hex_edge_ids[h][le];
-    const int axis = hex_edge_axis[le];
-    int t6 = hex_corner[hex_edges[le][0]][axis] ? 6 - n.p6[axis] : n.p6[axis];
-    if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t6 = 6 - t6;
+    const int32_t e = topology_.hex_edge_ids[h][n.local];
+    const int64_t t6 =
+        edge_position(input, topology_.edge_nodes[e], n.local, n.p6[hex_edge_axis[n.local]], 6);
     return edge_slot_[3 * static_cast<size_t>(e) + t6 - 2];
   }
-  const int lf = n.local;
-  const auto& fr = face_frame(input, lf, frame);
-  const int* o = hex_corner[fr[0]];
-  const int* c1 = hex_corner[fr[1]];
-  const int* c3 = hex_corner[fr[2]];
-  int u6 = 0, v6 = 0;
-  for (int k = 0; k < 3; ++k) {
-    u6 += (c1[k] - o[k]) * (n.p6[k] - 6 * o[k]);
-    v6 += (c3[k] - o[k]) * (n.p6[k] - 6 * o[k]);
-  }
-  int32_t& base = face_base_[topology_.hex_face_ids[h][lf]];
+  const auto uv = face_position(face_frame(input, n.local, frame), n.p6, 6);
+  int32_t& base = face_base_[topology_.hex_face_ids[h][n.local]];
   if (base < 0) {
     base = static_cast<int32_t>(face_slot_.size());
     face_slot_.resize(face_slot_.size() + 9, -1);
   }
-  return face_slot_[base + 3 * (u6 - 2) + (v6 - 2)];
+  return face_slot_[base + 3 * (uv[0] - 2) + (uv[1] - 2)];
 }
 
 TemplateNodeKey TemplateRefiner::plan_node_key(int32_t h, const TemplatePlanNode& n,
                                                std::array<std::array<int8_t, 3>, 6>& frame) const {
   const HexCell& input = mesh_.hexes[h];
   if (n.kind == TemplateNodeKey::edge) {
-    const int le = n.local;
-    const int32_t e = topology_.hex_edge_ids[h][le];
-    const int axis = hex_edge_axis[le];
-    int64_t t = hex_corner[hex_edges[le][0]][axis] ? kUnit - n.param[axis] : n.param[axis];
-    if (input[hex_edges[le][0]] != topology_.edge_nodes[e][0]) t = kUnit - t;
-    return make_key(TemplateNodeKey::edge, e, t);
+    const int32_t e = topology_.hex_edge_ids[h][n.local];
+    return make_key(TemplateNodeKey::edge, e,
+                    edge_position(input, topology_.edge_nodes[e], n.local,
+                                  n.param[hex_edge_axis[n.local]], kUnit));
   }
-  const int lf = n.local;
-  const auto& fr = face_frame(input, lf, frame);
-  const int* o = hex_corner[fr[0]];
-  const int* c1 = hex_corner[fr[1]];
-  const int* c3 = hex_corner[fr[2]];
-  int64_t u = 0, v = 0;
-  for (int k = 0; k < 3; ++k) {
-    u += (c1[k] - o[k]) * (n.param[k] - o[k] * kUnit);
-    v += (c3[k] - o[k]) * (n.param[k] - o[k] * kUnit);
-  }
-  return make_key(TemplateNodeKey::face, topology_.hex_face_ids[h][lf], u, v);
+  const auto uv = face_position(face_frame(input, n.local, frame), n.param, kUnit);
+  return make_key(TemplateNodeKey::face, topology_.hex_face_ids[h][n.local], uv[0], uv[1]);
 }
 
 void TemplateRefiner::apply_whole_batch(std::span<const TemplateApplication> apps,

@@ -53,6 +53,12 @@ inline std::string test_file_text(const std::filesystem::path& p) {
   return ss.str();
 }
 
+/// Writes `text` to a file (replacing it), byte for byte.
+inline void test_file_put(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+}
+
 /// Path of a file in ../shared/meshes.
 inline std::string shared_mesh(const std::string& name) {
   return std::string(HEXREFINE_SHARED_DIR) + "/meshes/" + name;

@@ -16,11 +16,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-void file_put(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-}
-
 json record(const std::string& name, int case_index, const std::string& method, int method_index) {
   return json{{"case", name},
               {"case_index", case_index},
@@ -31,8 +26,9 @@ json record(const std::string& name, int case_index, const std::string& method, 
 
 TEST(CliRun, BadCaseFileExitsTwoNamingFileAndPath) {
   const auto dir = test_temp_dir("cli_run_bad");
-  file_put(dir / "c.json",
-           R"({"cases":[{"name":"a","mesh":{"generate":"brick","dims":[2,2]},"select":["all"]}]})");
+  test_file_put(
+      dir / "c.json",
+      R"({"cases":[{"name":"a","mesh":{"generate":"brick","dims":[2,2]},"select":["all"]}]})");
   const CliRun r = cli_run("run " + (dir / "c.json").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("c.json: /cases/0/mesh/dims: expected 3 integers"), std::string::npos)
@@ -48,12 +44,12 @@ TEST(CliRun, BadCaseFileExitsTwoNamingFileAndPath) {
 
 TEST(CliRun, ResumeOfAFinishedRunRunsNothing) {
   const auto dir = test_temp_dir("cli_run_resume");
-  file_put(dir / "c.json", R"({"cases":[{"name":"a","mesh":{"generate":"brick","dims":[2,2,2]},
+  test_file_put(dir / "c.json", R"({"cases":[{"name":"a","mesh":{"generate":"brick","dims":[2,2,2]},
     "select":["all"]}], "output": "out/a.jsonl"})");
   fs::create_directories(dir / "out");
   const std::string done =
       record("a", 0, "selective", 0).dump() + "\n" + record("a", 0, "sheet", 1).dump() + "\n";
-  file_put(dir / "out" / "a.jsonl", done);
+  test_file_put(dir / "out" / "a.jsonl", done);
   const CliRun r = cli_run("run " + (dir / "c.json").string() + " --resume");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("0 records written (2 already present"), std::string::npos) << r.output;
@@ -69,11 +65,11 @@ TEST(CliReproduce, RefusesStrayArguments) {
 
 TEST(CliMerge, JoinsShardsDeduplicatedInCaseOrder) {
   const auto dir = test_temp_dir("cli_merge");
-  file_put(dir / "s2.jsonl",
-           record("b", 1, "selective", 0).dump() + "\n" + record("b", 1, "sheet", 1).dump() + "\n");
-  file_put(dir / "s1.jsonl", record("c", 2, "sheet", 1).dump() + "\n" +
-                                 record("a", 0, "selective", 0).dump() + "\n" +
-                                 record("b", 1, "sheet", 1).dump() + "\n{\"case\":\"x");
+  test_file_put(dir / "s2.jsonl", record("b", 1, "selective", 0).dump() + "\n" +
+                                      record("b", 1, "sheet", 1).dump() + "\n");
+  test_file_put(dir / "s1.jsonl", record("c", 2, "sheet", 1).dump() + "\n" +
+                                      record("a", 0, "selective", 0).dump() + "\n" +
+                                      record("b", 1, "sheet", 1).dump() + "\n{\"case\":\"x");
   const CliRun r = cli_run("merge " + (dir / "all.jsonl").string() + " " +
                            (dir / "s2.jsonl").string() + " " + (dir / "s1.jsonl").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -90,7 +86,7 @@ TEST(CliMerge, JoinsShardsDeduplicatedInCaseOrder) {
   EXPECT_EQ(cli_run("merge " + (dir / "x.jsonl").string() + " " + (dir / "none.jsonl").string())
                 .exit_code,
             2);
-  file_put(dir / "bad.jsonl", "nonsense\n" + record("a", 0, "sheet", 1).dump() + "\n");
+  test_file_put(dir / "bad.jsonl", "nonsense\n" + record("a", 0, "sheet", 1).dump() + "\n");
   const CliRun bad =
       cli_run("merge " + (dir / "x.jsonl").string() + " " + (dir / "bad.jsonl").string());
   EXPECT_EQ(bad.exit_code, 2);
@@ -107,10 +103,10 @@ namespace {
 TEST(CliRun, RunsBothMethodsOnTheSameTargetsAndChecksTheOutputs) {
   const auto dir = test_temp_dir("cli_run_real");
   const std::string abaqus = shared_mesh("abaqus_hex_2x2x2.inp");
-  file_put(dir / "c.json", R"({"cases":[
+  test_file_put(dir / "c.json", R"({"cases":[
     {"name":"full","mesh":{"generate":"brick","dims":[3,3,3]},"select":["all"],"save_mesh":true},
     {"name":"inp","mesh":{"file":")" +
-                               abaqus + R"("},"select":["all"],"methods":["selective"]},
+                                    abaqus + R"("},"select":["all"],"methods":["selective"]},
     {"name":"bad-spec","mesh":{"generate":"brick","dims":[2,2,2]},"select":["boxx:1"],
      "methods":["sheet"]}],
     "output":"r.jsonl"})");
@@ -177,8 +173,9 @@ TEST(PlotsPy, PutsOursBesideTheThesisWithRatios) {
   sweep["tags"] = {{"table", "G-2"}, {"n", 10}};
   sweep["initial_hexes"] = 1000;
   sweep["error"] = "sheet refinement refused";
-  file_put(dir / "r.jsonl", g1("selective", 8060, 0.0797, 0.3077).dump() + "\n" +
-                                g1("sheet", 27000, 3.242, 1.0).dump() + "\n" + sweep.dump() + "\n");
+  test_file_put(dir / "r.jsonl", g1("selective", 8060, 0.0797, 0.3077).dump() + "\n" +
+                                     g1("sheet", 27000, 3.242, 1.0).dump() + "\n" + sweep.dump() +
+                                     "\n");
   const std::string thesis = std::string(HEXREFINE_SHARED_DIR) + "/thesis/tables.json";
   const CliRun r = plots_py((dir / "r.jsonl").string() + " --thesis " + thesis + " --out " +
                             (dir / "out").string() + " --quiet");
@@ -194,7 +191,7 @@ TEST(PlotsPy, PutsOursBesideTheThesisWithRatios) {
   EXPECT_NE(md.find("error: sheet refinement refused"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "out" / "plots" / "G-2_time.png"));
 
-  file_put(dir / "bad.jsonl", "nonsense\n{}\n");
+  test_file_put(dir / "bad.jsonl", "nonsense\n{}\n");
   const CliRun bad = plots_py((dir / "bad.jsonl").string() + " --thesis " + thesis + " --out " +
                               (dir / "out").string());
   EXPECT_EQ(bad.exit_code, 2);

@@ -17,11 +17,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-void file_put(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-}
-
 /// The message of the InputError `f` throws ("" if it throws nothing or something else).
 template <typename F>
 std::string input_error_of(F f) {
@@ -91,14 +86,14 @@ TEST(Sha256, KnownDigests) {
 
 TEST(Sha256, OfFileMatchesOfBytes) {
   const auto dir = test_temp_dir("runner_sha_file");
-  file_put(dir / "m.txt", "abc");
+  test_file_put(dir / "m.txt", "abc");
   EXPECT_EQ(sha256_file((dir / "m.txt").string()), sha256_hex("abc"));
   EXPECT_NE(input_error_of([&] { sha256_file((dir / "missing.txt").string()); }), "");
 }
 
 TEST(RunPlan, ParsesDefaultsAndResolvesRelativePaths) {
   const auto dir = test_temp_dir("runner_parse");
-  file_put(dir / "m.mesh", "x");
+  test_file_put(dir / "m.mesh", "x");
   const json root = {{"cases",
                       {brick_case("a"),
                        {{"name", "b"},
@@ -189,7 +184,7 @@ TEST(RunPlan, SchemaErrorsNameFileAndJsonPath) {
 
 TEST(RunPlan, ReadReportsSyntaxErrorLine) {
   const auto dir = test_temp_dir("runner_read");
-  file_put(dir / "bad.json", "{\"cases\": [\n  {\"name\": \"a\",\n   \"mesh\": }\n]}\n");
+  test_file_put(dir / "bad.json", "{\"cases\": [\n  {\"name\": \"a\",\n   \"mesh\": }\n]}\n");
   const std::string e = input_error_of([&] { run_plan_read((dir / "bad.json").string()); });
   EXPECT_EQ(e.rfind((dir / "bad.json").string() + ":3: invalid JSON", 0), 0u) << e;
   EXPECT_NE(input_error_of([&] { run_plan_read((dir / "none.json").string()); }), "");
@@ -231,22 +226,22 @@ TEST(Jsonl, DropsTruncatedLastLineOnly) {
   const auto dir = test_temp_dir("runner_jsonl_trunc");
   const std::string path = (dir / "r.jsonl").string();
   const std::string good = "{\"case\":\"a\",\"method\":\"sheet\",\"options\":{}}\n";
-  file_put(path, good + "{\"case\":\"b\",\"meth");
+  test_file_put(path, good + "{\"case\":\"b\",\"meth");
   JsonlContent c = jsonl_read(path);
   EXPECT_EQ(c.records.size(), 1u);
   EXPECT_TRUE(c.truncated_tail);
   EXPECT_EQ(c.valid_text, good);
   // A complete record without its final newline is also treated as cut short.
-  file_put(path, good + good.substr(0, good.size() - 1));
+  test_file_put(path, good + good.substr(0, good.size() - 1));
   c = jsonl_read(path);
   EXPECT_EQ(c.records.size(), 1u);
   EXPECT_TRUE(c.truncated_tail);
   // A bad line in the middle is bad input, named by line.
-  file_put(path, good + "garbage\n");
+  test_file_put(path, good + "garbage\n");
   EXPECT_EQ(input_error_of([&] { jsonl_read(path); }), path + ":2: not a JSON record");
-  file_put(path, good + "garbage\n" + good);
+  test_file_put(path, good + "garbage\n" + good);
   EXPECT_EQ(input_error_of([&] { jsonl_read(path); }), path + ":2: not a JSON record");
-  file_put(path, good + "{\"case\":\"a\"}\n");
+  test_file_put(path, good + "{\"case\":\"a\"}\n");
   EXPECT_EQ(input_error_of([&] { jsonl_read(path); }).rfind(path + ":2: record without", 0), 0u);
 }
 
@@ -307,7 +302,7 @@ TEST(RunPlanExecute, ResumeAfterKilledRunLosesNothingAndRepeatsNothing) {
   size_t pos = 0;
   for (int i = 0; i < 5; ++i) pos = text.find('\n', pos) + 1;
   const size_t sixth_end = text.find('\n', pos);
-  file_put(out, text.substr(0, pos + (sixth_end - pos) / 2));
+  test_file_put(out, text.substr(0, pos + (sixth_end - pos) / 2));
 
   RunSettings settings = quiet_settings();
   settings.resume = true;

@@ -1,70 +1,167 @@
 #include "algorithms/refiner.hpp"
 
 #include <array>
+#include <chrono>
+#include <string>
+
+#include "algorithms/selective.hpp"
+#include "algorithms/sheet.hpp"
+#include "mesh/error.hpp"
+#include "mesh/quality.hpp"
 
 namespace hexrefine {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+constexpr std::array<RefineMethod, 2> methods = {{
+    {"selective",
+     "the Selective Approach: element-by-element templates, directional refinement with ranking "
+     "and propagation (Parrish)",
+     selective_plan, true},
+    {"sheet", "Harris-style sheet refinement: one dual sheet at a time, targets grown", sheet_plan,
+     false},
+}};
+
+void targets_validate(const HexMesh& mesh, const Targets& targets, std::string_view method) {
+  int32_t previous = -1;
+  for (int32_t t : targets.hexes) {
+    if (t < 0 || t >= mesh.hex_count())
+      throw InputError(std::string(method) + ": target hex " + std::to_string(t) +
+                       " is not in the mesh (0.." + std::to_string(mesh.hex_count() - 1) + ")");
+    if (t <= previous)
+      throw InputError(std::string(method) + ": targets must be ascending and unique (hex " +
+                       std::to_string(t) + " after " + std::to_string(previous) + ")");
+    previous = t;
+  }
+}
+
+/// Refuses an input with hexes of scaled Jacobian <= 0, naming up to ten with their values.
+void input_validate(const HexMesh& mesh, std::string_view method) {
+  int64_t inverted = 0;
+  std::string list;
+  for (int32_t h = 0; h < mesh.hex_count(); ++h) {
+    const double sj = hex_scaled_jacobian(hex_points(mesh, h));
+    if (sj > 0) continue;
+    if (++inverted <= 10)
+      list += (list.empty() ? "" : ", ") + std::to_string(h) + " (" + std::to_string(sj) + ")";
+  }
+  if (inverted)
+    throw InputError(std::string(method) + ": " + std::to_string(inverted) +
+                     " input hexes have a scaled Jacobian <= 0 (inverted or degenerate), no "
+                     "refinement of them can be valid: hex (scaled Jacobian) " +
+                     list + (inverted > 10 ? ", ..." : "") +
+                     " (allow_inverted, --allow-inverted, refines them anyway)");
+}
+
+}  // namespace
+
+void refine_input_validate(const HexMesh& mesh, const Targets& targets,
+                           const RefineOptions& options, std::string_view method) {
+  targets_validate(mesh, targets, method);
+  if (options.passes < 1)
+    throw InputError(std::string(method) + ": passes must be at least 1, got " +
+                     std::to_string(options.passes));
+  if (options.threads < 1)
+    throw InputError(std::string(method) + ": threads must be at least 1, got " +
+                     std::to_string(options.threads));
+  if (!options.allow_inverted) input_validate(mesh, method);
+}
 
 void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags) {
   // One counter per tag value first: a string-keyed map lookup per hex would cost more than
   // the refinement itself on large meshes.
-  std::array<int64_t, 10> known{};
+  std::array<int64_t, template_tag_count> known{};
   for (int32_t t : tags) {
-    if (t >= 0 && t < static_cast<int32_t>(known.size()))
+    if (t >= 0 && t < template_tag_count)
       ++known[t];
     else
       ++stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(t))];
   }
-  for (size_t t = 0; t < known.size(); ++t)
+  for (int t = 0; t < template_tag_count; ++t)
     if (known[t])
       stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(t))] += known[t];
 }
 
-const char* template_tag_name(TemplateTag tag) {
-  switch (tag) {
-    case TemplateTag::untouched:
-      return "untouched";
-    case TemplateTag::t1_27:
-      return "1-27";
-    case TemplateTag::t1_13:
-      return "1-13";
-    case TemplateTag::t1_5:
-      return "1-5";
-    case TemplateTag::t1_4:
-      return "1-4";
-    case TemplateTag::t1_3:
-      return "1-3";
-    case TemplateTag::t1_3_adjust1:
-      return "1-3-adj1";
-    case TemplateTag::t1_3_adjust2:
-      return "1-3-adj2";
-    case TemplateTag::directional:
-      return "directional";
-    case TemplateTag::sheet:
-      return "sheet";
-  }
-  return "unknown";
+std::span<const RefineMethod> refine_methods() {
+  return methods;
 }
 
-nlohmann::json refine_stats_to_json(const RefineStats& s) {
-  nlohmann::json j;
-  j["method"] = s.method;
-  j["initial_hexes"] = s.initial_hexes;
-  j["final_hexes"] = s.final_hexes;
-  j["final_nodes"] = s.final_nodes;
-  j["hexes_per_template"] = s.hexes_per_template;
-  j["hexes_created"] = s.hexes_created;
-  j["hexes_deleted"] = s.hexes_deleted;
-  j["directional_hexes"] = s.directional_hexes;
-  j["directional_groups"] = s.directional_groups;
-  j["ranks"] = s.ranks;
-  j["doublets_resolved"] = s.doublets_resolved;
-  j["edges_split_by_propagation"] = s.edges_split_by_propagation;
-  j["sheet_passes"] = s.sheet_passes;
-  j["added_targets"] = s.added_targets;
-  j["self_intersection_cases"] = s.self_intersection_cases;
-  j["phase_seconds"] = s.phase_seconds;
-  j["time_seconds"] = s.time_seconds;
-  return j;
+const RefineMethod& refine_method(std::string_view name) {
+  std::string known;
+  for (const RefineMethod& m : methods) {
+    if (m.name == name) return m;
+    known += (known.empty() ? "" : ", ") + std::string(m.name);
+  }
+  throw InputError("unknown refinement method '" + std::string(name) +
+                   "' (expected one of: " + known + ")");
+}
+
+RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targets& targets,
+                    const RefineOptions& options) {
+  const auto t0 = Clock::now();
+  const std::string name(method.name);
+  refine_input_validate(mesh, targets, options, name);
+
+  RefineResult result;
+  RefineStats& stats = result.stats;
+  stats.method = name;
+  stats.initial_hexes = mesh.hex_count();
+  for (const char* phase : {"plan", "apply", "placement"}) stats.phase_seconds[phase] = 0;
+
+  // The mesh a pass refines: the input for the first pass (not copied, its parent_hex dropped
+  // by the engine's rule: the output's parent_hex names the input's hexes), the previous
+  // pass's output after that.
+  HexMesh input_without_parent;
+  const HexMesh* current = &mesh;
+  if (mesh_find_attribute(mesh, attribute_parent_hex)) {
+    input_without_parent = mesh;
+    std::erase_if(input_without_parent.attributes,
+                  [](const HexAttribute& a) { return a.name == attribute_parent_hex; });
+    current = &input_without_parent;
+  }
+  HexMesh output;
+  std::vector<int32_t> pass_targets = targets.hexes;
+  for (int pass = 0; pass < options.passes; ++pass) {
+    auto t = Clock::now();
+    const HexTopology topology = topology_build(*current);
+    const RefinementPlan plan = method.plan(*current, topology, pass_targets, options, stats);
+    stats.phase_seconds["plan"] += seconds_since(t);
+
+    t = Clock::now();
+    PlanApplyResult applied = plan_apply(*current, topology, plan, options.threads);
+    stats.phase_seconds["apply"] += seconds_since(t);
+
+    if (pass + 1 < options.passes) {
+      // The next pass refines the descendants of this pass's targets (and its transitions'
+      // with the buffer).
+      std::vector<int32_t> next;
+      for (size_t u = 0; u < plan.uses.size(); ++u) {
+        const TemplateUse& use = plan.uses[u];
+        const bool carried = use.target || (options.buffer && method.uses_buffer);
+        if (!carried) continue;
+        const int32_t first = applied.first_child[u];
+        const int32_t count = static_cast<int32_t>(use.tmpl->children.size());
+        for (int32_t c = first; c < first + count; ++c) next.push_back(c);
+        if (!use.target) stats.added_targets += count;
+      }
+      pass_targets = std::move(next);
+    }
+    output = std::move(applied.mesh);
+    current = &output;
+  }
+  result.mesh = std::move(output);
+  stats.final_hexes = result.mesh.hex_count();
+  stats.final_nodes = result.mesh.point_count();
+  stats_count_templates(stats, *mesh_find_attribute(result.mesh, attribute_template_tag));
+  stats.time_seconds = seconds_since(t0);
+  stats.phase_seconds["total"] = stats.time_seconds;
+  return result;
 }
 
 }  // namespace hexrefine

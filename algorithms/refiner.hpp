@@ -1,39 +1,27 @@
 #pragma once
 /// \file
 /// The interface both refiners share (the Selective Approach and Harris-style sheet refinement):
-/// the same targets, options, result and statistics, so experiments compare like with like.
+/// the same targets, options, statistics and result, and one registry of methods by name, so
+/// that every front end (CLI, runner, benchmarks, Python) runs them alike.
+///
+/// A method decides one pass and returns a plan (template_engine.hpp); `refine` runs the passes:
+/// for each, the method's plan, the engine's application of it, then node placement
+/// (node_placement.hpp) over the new nodes, then the next pass's targets.
 
 #include <cstdint>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "algorithms/node_placement.hpp"
+#include "algorithms/template_engine.hpp"
 #include "mesh/hex_mesh.hpp"
+#include "mesh/topology.hpp"
 
 namespace hexrefine {
-
-/// Template tag written per output hex (attribute "template_tag"). Untouched hexes keep 0.
-enum class TemplateTag : int32_t {
-  untouched = 0,
-  t1_27 = 1,
-  t1_13 = 2,
-  t1_5 = 3,
-  t1_4 = 4,
-  t1_3 = 5,
-  t1_3_adjust1 = 6,
-  t1_3_adjust2 = 7,
-  directional = 8,  ///< produced by directional refinement (several templates in sequence)
-  sheet = 9,        ///< produced by sheet refinement passes
-};
-
-/// Short name used in reports ("1-27", "1-3-adj1", ...).
-const char* template_tag_name(TemplateTag tag);
-
-struct RefineStats;
-/// Fills stats.hexes_per_template from a list of per-hex template tags (values outside the
-/// enumeration are counted under template_tag_name's name for them).
-void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags);
 
 /// The hexes selected for refinement: ascending, unique ids into the input mesh.
 struct Targets {
@@ -45,13 +33,16 @@ struct RefineOptions {
   bool propagation = true;  ///< Selective: propagation scheme after each directional step.
   bool ebe_only = false;    ///< Selective: element-by-element only (as Schneiders).
   int passes = 1;           ///< Refine the region this many times.
-  bool buffer = false;      ///< Add the previous pass's transition layer to the next targets.
-  bool allow_inverted = false;
+  bool buffer = false;      ///< Selective: the previous pass's transitions join the next targets.
+  bool allow_inverted = false;  ///< Refine an input with inverted hexes (no refusal).
   /// Threads for applying whole-hex templates (the assembly of the output). The output is
   /// identical for every count: node ids are claimed in hex order first, then the positions
   /// and children are written in parallel. 1: everything in the calling thread.
   int threads = 1;
+  PlacementOptions placement;  ///< where the new nodes go after each pass
 };
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RefineOptions, ranking, propagation, ebe_only,
+                                                passes, buffer, allow_inverted, threads, placement)
 
 /// Statistics of one refinement. Fields a method does not use stay zero.
 struct RefineStats {
@@ -66,21 +57,68 @@ struct RefineStats {
   int64_t directional_groups = 0;
   int64_t ranks = 0;
   int64_t doublets_resolved = 0;
+  std::map<std::string, int64_t> doublets_by_rule;  ///< doublets_resolved split by rule
   int64_t edges_split_by_propagation = 0;
   int64_t sheet_passes = 0;
   int64_t added_targets = 0;
   int64_t self_intersection_cases = 0;
-  std::map<std::string, double> phase_seconds;  ///< marking, element_by_element, ranking, ...
-  double time_seconds = 0;                      ///< refinement only, no I/O
+  PlacementStats placement;
+  /// Seconds per phase: the method's own (marking, element_by_element, ranking, ...) and the
+  /// driver's (plan, apply, placement, total).
+  std::map<std::string, double> phase_seconds;
+  double time_seconds = 0;  ///< refinement with placement, no I/O
 };
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(
+    RefineStats, method, initial_hexes, final_hexes, final_nodes, hexes_per_template, hexes_created,
+    hexes_deleted, directional_hexes, directional_groups, ranks, doublets_resolved,
+    doublets_by_rule, edges_split_by_propagation, sheet_passes, added_targets,
+    self_intersection_cases, placement, phase_seconds, time_seconds)
 
-nlohmann::json refine_stats_to_json(const RefineStats& s);
+/// Fills stats.hexes_per_template from a list of per-hex template tags.
+void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags);
 
-/// Output of a refiner: the new mesh (with attribute "template_tag" and "refinement_level"),
-/// and its statistics.
+/// Output of a refinement: the new mesh (attributes "template_tag", "refinement_level",
+/// "parent_hex", plus the input's, inherited) and its statistics.
 struct RefineResult {
   HexMesh mesh;
   RefineStats stats;
 };
+
+/// A refinement method: decides one pass over `mesh`. `targets` are ascending, unique and in
+/// range; `topology` was built from `mesh` (TopologyParts::all). The plan's uses mark the
+/// targets (TemplateUse::target). Throws OperationError naming the hexes where the method cannot
+/// handle the configuration.
+using RefinePlanFn = RefinementPlan (*)(const HexMesh& mesh, const HexTopology& topology,
+                                        const std::vector<int32_t>& targets,
+                                        const RefineOptions& options, RefineStats& stats);
+
+struct RefineMethod {
+  std::string_view name;
+  std::string_view description;  ///< one line, for --help
+  RefinePlanFn plan;
+  /// RefineOptions::buffer applies (the method refines transitions the next pass must redo).
+  bool uses_buffer;
+};
+
+/// Every method, in a fixed order ("selective", "sheet").
+std::span<const RefineMethod> refine_methods();
+
+/// The method called `name`; InputError listing the known names otherwise.
+const RefineMethod& refine_method(std::string_view name);
+
+/// The checks refine() makes before any work: targets ascending, unique and in range, passes and
+/// threads >= 1, and (unless options.allow_inverted) no input hex with a scaled Jacobian <= 0.
+/// Throws InputError naming `method` and the offending hexes (with their scaled Jacobians).
+void refine_input_validate(const HexMesh& mesh, const Targets& targets,
+                           const RefineOptions& options, std::string_view method);
+
+/// Refines `targets` of `mesh` by `method`, options.passes times: each pass plans, applies the
+/// plan and places the new nodes; the next pass refines the descendants of this pass's targets
+/// (and with options.buffer, for methods that use it, those of its transitions too). Throws
+/// InputError for invalid targets or options, or (unless options.allow_inverted) an input with
+/// hexes of scaled Jacobian <= 0, naming them; OperationError where the method refuses or no
+/// valid placement was found, naming the hexes.
+RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targets& targets,
+                    const RefineOptions& options);
 
 }  // namespace hexrefine

@@ -6,8 +6,14 @@
 
 namespace hexrefine {
 
-/// Refines `targets` of `mesh` by the Selective Approach. Throws OperationError naming the hexes
-/// when a configuration cannot be handled (never returns a broken mesh).
+/// Decides one pass of the Selective Approach (RefinePlanFn): 1-27 on the targets, the
+/// element-by-element template on each transition hex that has one, directional refinement of
+/// the others (a template of its cells per hex), the adjustments' aliases.
+RefinementPlan selective_plan(const HexMesh& mesh, const HexTopology& topology,
+                              const std::vector<int32_t>& targets, const RefineOptions& options,
+                              RefineStats& stats);
+
+/// refine(refine_method("selective"), mesh, targets, options).
 RefineResult selective_refine(const HexMesh& mesh, const Targets& targets,
                               const RefineOptions& options);
 

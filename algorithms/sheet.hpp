@@ -53,18 +53,22 @@ SheetMarking sheet_mark(const HexMesh& mesh, const HexTopology& topology, const 
 /// and the round index; for tests and figures. Assembling the mesh costs a copy per round.
 using SheetRoundObserver = std::function<void(const HexMesh& mesh, int round)>;
 
-/// Refines `targets` of `mesh` one direction at a time, sheet by sheet. Output attributes:
-/// those of the input, inherited; "template_tag" = TemplateTag::sheet on every hex produced by
-/// sheet passes (untouched hexes keep theirs, or 0); "refinement_level" = the parent's + 1 per
-/// pass (options.passes). A dual sheet crossing itself in a fully refined hex is handled (both
-/// directions in one pass, template 1-9); stats.self_intersection_cases counts the refined hexes
-/// a dual sheet crosses itself in. Throws InputError for invalid targets, OperationError naming
-/// the sheet and hexes for a case it refuses (a sheet crossing itself in a transition hex that
-/// it must refine in two directions): never returns a non-conformal mesh.
+/// Decides one pass of sheet refinement (RefinePlanFn): per refined hex, the composite template of
+/// its rounds (sheet_rounds.cpp). Every refined hex is tagged TemplateTag::sheet. A dual sheet
+/// crossing itself in a fully refined hex is handled (both directions in one pass, template 1-9);
+/// stats.self_intersection_cases counts the refined hexes a dual sheet crosses itself in. Throws
+/// OperationError naming the sheet and hexes for a case it refuses (a sheet crossing itself in a
+/// transition hex that it must refine in two directions, or neighbours whose sheets would split
+/// their shared face in different passes).
+RefinementPlan sheet_plan(const HexMesh& mesh, const HexTopology& topology,
+                          const std::vector<int32_t>& targets, const RefineOptions& options,
+                          RefineStats& stats);
+
+/// refine(refine_method("sheet"), mesh, targets, options).
 RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets,
                           const RefineOptions& options);
 
-/// As above, with an observer of the intermediate meshes.
+/// As above, with an observer of the intermediate meshes (the round-by-round formulation).
 RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const RefineOptions& options,
                           const SheetRoundObserver& observer);
 
@@ -75,11 +79,11 @@ struct SheetControl {
   /// share no hex together. Same result; one copy of the refined region per sheet (slower).
   bool one_sheet_per_round = false;
   /// Replay each hex configuration's rounds once on the reference cube and apply the result as
-  /// one composite template (the default; the same mesh up to rounding in transition hexes,
-  /// whose later nodes are placed by the input hex's map instead of the intermediate hex's).
-  /// false, an observer or one_sheet_per_round: the rounds run on the whole refined region,
-  /// building every intermediate mesh and its topology (Harris' formulation, as the thesis
-  /// timed it).
+  /// one composite template (the default, sheet_plan; the same mesh up to rounding in transition
+  /// hexes, whose later nodes are placed by the input hex's map instead of the intermediate
+  /// hex's). false, an observer or one_sheet_per_round: every round is a plan applied to the
+  /// whole mesh, building every intermediate mesh and its topology (Harris' formulation, as the
+  /// thesis timed it); then no node placement runs (options.placement is ignored).
   bool composites = true;
 };
 

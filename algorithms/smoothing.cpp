@@ -516,8 +516,10 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
       movable.push_back(n);
 
   Smoother smoother(mesh, topology, classes, options.method);
-  stats_min_mean(smoother.quality(), stats.min_scaled_jacobian_before, stats.mean_before);
-  double current_min = stats.min_scaled_jacobian_before, current_mean = stats.mean_before;
+  stats_min_mean(smoother.quality(), stats.min_scaled_jacobian_before,
+                 stats.mean_scaled_jacobian_before);
+  double current_min = stats.min_scaled_jacobian_before,
+         current_mean = stats.mean_scaled_jacobian_before;
 
   // Worst-first order by a counting sort on the quantised local minimum (linear, stable by id).
   // Only active nodes are visited: those whose hexes changed since their last visit.
@@ -561,7 +563,8 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
     if (largest_relative_move <= 1e-7 || stalled) break;
   }
 
-  stats_min_mean(smoother.quality(), stats.min_scaled_jacobian_after, stats.mean_after);
+  stats_min_mean(smoother.quality(), stats.min_scaled_jacobian_after,
+                 stats.mean_scaled_jacobian_after);
   for (int32_t n = 0; n < mesh.point_count(); ++n)
     if (mesh.points[n] != smoother.input_points()[n]) ++stats.nodes_moved;
   stats.seconds =
@@ -576,16 +579,6 @@ std::vector<int32_t> mesh_refined_hexes(const HexMesh& mesh) {
   for (int32_t h = 0; h < static_cast<int32_t>(tags->size()); ++h)
     if ((*tags)[h] != 0) out.push_back(h);
   return out;
-}
-
-nlohmann::json smooth_stats_to_json(const SmoothStats& s) {
-  return {{"min_scaled_jacobian_before", s.min_scaled_jacobian_before},
-          {"min_scaled_jacobian_after", s.min_scaled_jacobian_after},
-          {"mean_scaled_jacobian_before", s.mean_before},
-          {"mean_scaled_jacobian_after", s.mean_after},
-          {"seconds", s.seconds},
-          {"sweeps", s.sweeps},
-          {"nodes_moved", s.nodes_moved}};
 }
 
 }  // namespace hexrefine

@@ -37,11 +37,17 @@ struct SmoothOptions {
 
 struct SmoothStats {
   double min_scaled_jacobian_before = 1, min_scaled_jacobian_after = 1;
-  double mean_before = 1, mean_after = 1;  ///< mean hex scaled Jacobian (1 for an empty mesh)
-  double seconds = 0;                      ///< smoothing only, no I/O
-  int sweeps = 0;                          ///< sweeps carried out (<= max_sweeps)
-  int64_t nodes_moved = 0;                 ///< nodes whose final position differs from the input
+  /// Mean hex scaled Jacobian (1 for an empty mesh).
+  double mean_scaled_jacobian_before = 1, mean_scaled_jacobian_after = 1;
+  double seconds = 0;       ///< smoothing only, no I/O
+  int sweeps = 0;           ///< sweeps carried out (<= max_sweeps)
+  int64_t nodes_moved = 0;  ///< nodes whose final position differs from the input
 };
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SmoothStats, min_scaled_jacobian_before,
+                                                min_scaled_jacobian_after,
+                                                mean_scaled_jacobian_before,
+                                                mean_scaled_jacobian_after, seconds, sweeps,
+                                                nodes_moved)
 
 /// How smoothing treats a node (mesh_smooth classifies every node once, before the sweeps).
 enum class SmoothNodeKind : int8_t {
@@ -71,10 +77,6 @@ SmoothNodeClasses mesh_classify_smooth_nodes(const HexMesh& mesh, const HexTopol
 /// sweeps, feature angle outside (0, 180), region hex id out of range) or a mesh failing
 /// mesh_validate_ids or holding a non-finite coordinate.
 SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options);
-
-/// The report of `hexrefine smooth` (and `refine --smooth`): min/mean scaled Jacobian before and
-/// after, seconds, sweeps, nodes moved.
-nlohmann::json smooth_stats_to_json(const SmoothStats& s);
 
 /// The default region of `refine --smooth`: the refined and transition hexes, i.e. those whose
 /// template_tag attribute is non-zero, ascending. Empty if there is none or the mesh has no

@@ -1,10 +1,10 @@
 #include "experiments/cli.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
-#include <map>
 #include <new>
 #include <sstream>
 
@@ -14,31 +14,75 @@ namespace hexrefine {
 
 namespace {
 
-const char* usage_text =
-    "usage: hexrefine COMMAND ...\n"
-    "  generate brick OUT --dims NX,NY,NZ [--size LX,LY,LZ] [--jitter F --seed S]\n"
-    "  generate gear|cylinder|twisted-ring|stepped OUT [options]\n"
-    "  check MESH [--reference REF] [--report R.json]\n"
-    "  convert IN OUT [--binary]\n"
-    "  sheets MESH [--report R.json]\n"
-    "  refine IN OUT --method selective|sheet --select SPEC [--select SPEC ...] [--passes N]\n"
-    "         [--buffer] [--smooth] [--no-ranking] [--no-propagation] [--ebe-only]\n"
-    "         [--allow-inverted] [--report R.json]\n"
-    "  smooth IN OUT [--method laplacian|optimize] [--region SPEC ...] [--sweeps N]\n"
-    "         [--report R.json]\n"
-    "  run CASES.json [--resume] [--quiet] [--shard K/N] [--output OUT.jsonl]\n"
-    "  reproduce [--quick] [--resume] [--quiet] [--no-plots]\n"
-    "  merge OUT.jsonl IN.jsonl [IN.jsonl ...]\n"
-    "  bench [--filter REGEX] [--out FILE.json] [--smoke] [--repetitions N]\n"
-    "  bench-compare BASE.json NEW.json [--threshold 0.05] [--by cpu|real]\n"
-    "exit codes: 0 done, 1 the operation failed, 2 bad usage or bad input\n";
+/// "[--name VALUE]" or "--name VALUE ..." as the usage shows an option.
+std::string option_synopsis(const CliOption& o) {
+  std::string s = o.name;
+  if (!o.value.empty()) s += " " + o.value;
+  if (o.repeatable) s += " ...";
+  return "[" + s + "]";
+}
+
+/// The top-level usage: every command with every option, wrapped.
+std::string usage_text() {
+  std::ostringstream out;
+  out << "usage: hexrefine COMMAND ...   (hexrefine COMMAND --help: the command's options)\n";
+  for (const CliCommand* c : cli_commands()) {
+    std::string line = "  " + c->name + (c->positionals.empty() ? "" : " " + c->positionals);
+    const std::string indent(4 + c->name.size(), ' ');
+    for (const CliOption& o : c->options) {
+      const std::string item = option_synopsis(o);
+      if (line.size() + 1 + item.size() > 100) {
+        out << line << "\n";
+        line = indent;
+      }
+      line += " " + item;
+    }
+    out << line << "\n";
+  }
+  out << "exit codes: 0 done, 1 the operation failed, 2 bad usage or bad input\n";
+  return out.str();
+}
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
 
 }  // namespace
 
+const std::vector<const CliCommand*>& cli_commands() {
+  static const std::vector<const CliCommand*> commands = {
+      &cli_generate_command, &cli_check_command,  &cli_convert_command,      &cli_sheets_command,
+      &cli_refine_command,   &cli_smooth_command, &cli_run_command,          &cli_reproduce_command,
+      &cli_merge_command,    &cli_bench_command,  &cli_bench_compare_command};
+  return commands;
+}
+
+std::string cli_closest(const std::string& word, const std::vector<std::string>& known) {
+  std::string best;
+  size_t best_distance = std::max<size_t>(2, word.size() / 3) + 1;
+  for (const std::string& k : known) {
+    const size_t d = edit_distance(word, k);
+    if (d < best_distance) {
+      best_distance = d;
+      best = k;
+    }
+  }
+  return best;
+}
+
 bool CliArgs::flag(const std::string& name) const {
-  for (const std::string& f : flags)
-    if (f == name) return true;
-  return false;
+  return std::find(flags.begin(), flags.end(), name) != flags.end();
 }
 
 std::optional<std::string> CliArgs::value(const std::string& name) const {
@@ -55,32 +99,55 @@ std::vector<std::string> CliArgs::all(const std::string& name) const {
   return out;
 }
 
-CliArgs cli_parse(const std::string& command, const std::vector<std::string>& args,
-                  const std::vector<std::string>& value_options,
-                  const std::vector<std::string>& flag_options) {
+CliArgs cli_parse(const CliCommand& command, const std::vector<std::string>& args) {
   CliArgs out;
-  auto is_in = [](const std::vector<std::string>& v, const std::string& s) {
-    for (const std::string& x : v)
-      if (x == s) return true;
-    return false;
-  };
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a.size() > 2 && a.compare(0, 2, "--") == 0) {
-      if (is_in(value_options, a)) {
-        if (i + 1 >= args.size())
-          throw InputError("hexrefine " + command + ": option " + a + " needs a value");
-        out.values.emplace_back(a, args[++i]);
-      } else if (is_in(flag_options, a)) {
-        out.flags.push_back(a);
-      } else {
-        throw InputError("hexrefine " + command + ": unknown option " + a);
-      }
-    } else {
+    if (a.size() <= 2 || a.compare(0, 2, "--") != 0) {
       out.positional.push_back(a);
+      continue;
+    }
+    const auto it = std::find_if(command.options.begin(), command.options.end(),
+                                 [&](const CliOption& o) { return o.name == a; });
+    if (it == command.options.end()) {
+      std::vector<std::string> known;
+      for (const CliOption& o : command.options) known.push_back(o.name);
+      const std::string near = cli_closest(a, known);
+      throw InputError("hexrefine " + command.name + ": unknown option " + a +
+                       (near.empty() ? "" : " (did you mean " + near + "?)") + "; hexrefine " +
+                       command.name + " --help lists the options");
+    }
+    if (it->value.empty()) {
+      out.flags.push_back(a);
+    } else {
+      if (i + 1 >= args.size())
+        throw InputError("hexrefine " + command.name + ": option " + a + " needs a value (" +
+                         it->value + ")");
+      out.values.emplace_back(a, args[++i]);
     }
   }
   return out;
+}
+
+std::string cli_help(const CliCommand& c) {
+  std::ostringstream out;
+  out << "usage: hexrefine " << c.name << (c.positionals.empty() ? "" : " " + c.positionals)
+      << (c.options.empty() ? "" : " [options]") << "\n"
+      << c.summary << "\n";
+  if (!c.options.empty()) {
+    out << "options:\n";
+    size_t width = 0;
+    for (const CliOption& o : c.options)
+      width = std::max(width, o.name.size() + (o.value.empty() ? 0 : o.value.size() + 1));
+    for (const CliOption& o : c.options) {
+      const std::string head = o.name + (o.value.empty() ? "" : " " + o.value);
+      out << "  " << head << std::string(width - head.size() + 2, ' ') << o.help
+          << (o.repeatable ? " (repeatable)" : "") << "\n";
+    }
+  }
+  if (!c.details.empty()) out << c.details;
+  if (c.more_help) out << c.more_help();
+  return out.str();
 }
 
 double cli_parse_double(const std::string& text, const std::string& what) {
@@ -98,6 +165,15 @@ long long cli_parse_int(const std::string& text, const std::string& what) {
   const long long v = std::strtoll(text.c_str(), &end, 10);
   if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE)
     throw InputError(what + ": expected an integer, got '" + text + "'");
+  return v;
+}
+
+long long cli_parse_int_in(const std::string& text, long long lo, long long hi,
+                           const std::string& what) {
+  const long long v = cli_parse_int(text, what);
+  if (v < lo || v > hi)
+    throw InputError(what + " must be in " + std::to_string(lo) + ".." + std::to_string(hi) +
+                     ", got '" + text + "'");
   return v;
 }
 
@@ -130,31 +206,36 @@ std::vector<int> cli_parse_ints(const std::string& text, int count, const std::s
 int cli_main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-    std::cout << usage_text;
+    std::cout << usage_text();
     return args.empty() ? 2 : 0;
   }
-  const std::string command = args[0];
+  const std::string name = args[0];
   args.erase(args.begin());
-  static const std::map<std::string, int (*)(const std::vector<std::string>&)> commands = {
-      {"generate", cli_generate},
-      {"check", cli_check},
-      {"convert", cli_convert},
-      {"sheets", cli_sheets},
-      {"refine", cli_refine},
-      {"smooth", cli_smooth},
-      {"run", cli_run},
-      {"reproduce", cli_reproduce},
-      {"merge", cli_merge},
-      {"bench", cli_bench},
-      {"bench-compare", cli_bench_compare},
-  };
-  const auto it = commands.find(command);
-  if (it == commands.end()) {
-    std::cerr << "hexrefine: unknown command '" << command << "'\n" << usage_text;
+  const CliCommand* command = nullptr;
+  std::vector<std::string> names;
+  for (const CliCommand* c : cli_commands()) {
+    if (c->name == name) command = c;
+    names.push_back(c->name);
+  }
+  if (!command) {
+    const std::string near = cli_closest(name, names);
+    std::cerr << "hexrefine: unknown command '" << name << "'"
+              << (near.empty() ? "" : " (did you mean " + near + "?)") << "\n"
+              << usage_text();
     return 2;
   }
+  if (std::find_if(args.begin(), args.end(),
+                   [](const std::string& a) { return a == "--help" || a == "-h"; }) != args.end()) {
+    std::cout << cli_help(*command);
+    return 0;
+  }
   try {
-    return it->second(args);
+    CliArgs parsed;
+    if (command->parses_itself)
+      parsed.positional = args;
+    else
+      parsed = cli_parse(*command, args);
+    return command->run(parsed);
   } catch (const InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;

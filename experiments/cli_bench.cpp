@@ -257,10 +257,7 @@ std::string seconds_text(double seconds) {
   return s.str();
 }
 
-}  // namespace
-
-int cli_bench(const std::vector<std::string>& args) {
-  const CliArgs a = cli_parse("bench", args, {"--filter", "--out", "--repetitions"}, {"--smoke"});
+int bench_run(const CliArgs& a) {
   if (!a.positional.empty())
     throw InputError("hexrefine bench: unexpected argument '" + a.positional[0] + "'");
   std::string options = " --benchmark_format=json";
@@ -318,8 +315,7 @@ int cli_bench(const std::vector<std::string>& args) {
   return 0;
 }
 
-int cli_bench_compare(const std::vector<std::string>& args) {
-  const CliArgs a = cli_parse("bench-compare", args, {"--threshold", "--by"}, {});
+int bench_compare_run(const CliArgs& a) {
   if (a.positional.size() != 2)
     throw InputError("hexrefine bench-compare: expected BASE.json NEW.json");
   double threshold = 0.05;
@@ -383,5 +379,33 @@ int cli_bench_compare(const std::vector<std::string>& args) {
             << only_new.size() << " missing in BASE\n";
   return 0;
 }
+
+}  // namespace
+
+const CliCommand cli_bench_command = {
+    "bench",
+    "",
+    "Runs the bench_* Google Benchmark executables and merges their JSON.",
+    {
+        {"--filter", "REGEX", "only the benchmarks whose name matches"},
+        {"--out", "FILE.json", "write the merged JSON here (default: stdout)"},
+        {"--repetitions", "N", "repeat each benchmark N times (1..1000): median and spread"},
+        {"--smoke", "", "smallest sizes only, minimal time (CI)"},
+    },
+    "",
+    bench_run,
+};
+
+const CliCommand cli_bench_compare_command = {
+    "bench-compare",
+    "BASE.json NEW.json",
+    "Compares two hexrefine bench files benchmark by benchmark (information, never fails).",
+    {
+        {"--threshold", "T", "flag ratios beyond 1 +- T (default 0.05)"},
+        {"--by", "cpu|real", "which time the flag follows (default cpu)"},
+    },
+    "",
+    bench_compare_run,
+};
 
 }  // namespace hexrefine

@@ -29,8 +29,9 @@ std::string format_number(double value) {
 
 }  // namespace
 
-int cli_check(const std::vector<std::string>& args) {
-  const CliArgs a = cli_parse("check", args, {"--report", "--reference"}, {});
+namespace {
+
+int check_run(const CliArgs& a) {
   if (a.positional.size() != 1)
     throw InputError(
         "hexrefine check: expected exactly one MESH argument (usage: hexrefine check "
@@ -46,7 +47,7 @@ int cli_check(const std::vector<std::string>& args) {
   int64_t self_intersecting = 0;
   for (const SheetInfo& s : dual.sheets) self_intersecting += s.self_intersecting;
 
-  nlohmann::json json = mesh_check_to_json(report);
+  nlohmann::json json = report;
   json["file"] = path;
   if (reference) json["reference_file"] = *a.value("--reference");
   json["sheets"] = dual.sheet_count();
@@ -83,5 +84,20 @@ int cli_check(const std::vector<std::string>& args) {
     file_write_atomically(*report_path, [&](std::ostream& os) { os << json.dump(2) << "\n"; });
   return report.valid() ? 0 : 1;
 }
+
+}  // namespace
+
+const CliCommand cli_check_command = {
+    "check",
+    "MESH",
+    "Checks a hex mesh: conformity, hanging nodes, doublets, inverted hexes, quality, dual sheets.",
+    {
+        {"--reference", "REF",
+         "the mesh before refinement: compare boundary, volume and area with it"},
+        {"--report", "R.json", "write the JSON report"},
+    },
+    "exit codes: 0 valid, 1 defects found (the report is still written), 2 bad usage or input\n",
+    check_run,
+};
 
 }  // namespace hexrefine

@@ -15,8 +15,9 @@
 
 namespace hexrefine {
 
-int cli_convert(const std::vector<std::string>& args) {
-  const CliArgs a = cli_parse("convert", args, {}, {"--binary"});
+namespace {
+
+int convert_run(const CliArgs& a) {
   if (a.positional.size() != 2)
     throw InputError("hexrefine convert: expected IN OUT (two paths), got " +
                      std::to_string(a.positional.size()) + " arguments");
@@ -37,5 +38,18 @@ int cli_convert(const std::vector<std::string>& args) {
             << mesh.hex_count() << " hexes\n";
   return 0;
 }
+
+}  // namespace
+
+const CliCommand cli_convert_command = {
+    "convert",
+    "IN OUT",
+    "Converts between mesh formats (by extension: .mesh .vtk .vtu .msh .e/.exo .inp).",
+    {
+        {"--binary", "", "VTK legacy output in BINARY instead of ASCII (.vtk only)"},
+    },
+    "",
+    convert_run,
+};
 
 }  // namespace hexrefine

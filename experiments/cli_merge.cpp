@@ -7,8 +7,9 @@
 
 namespace hexrefine {
 
-int cli_merge(const std::vector<std::string>& args) {
-  const CliArgs a = cli_parse("merge", args, {}, {"--quiet"});
+namespace {
+
+int merge_run(const CliArgs& a) {
   if (a.positional.size() < 2)
     throw InputError("hexrefine merge: expected OUT.jsonl and at least one IN.jsonl");
   std::vector<std::vector<nlohmann::json>> inputs;
@@ -26,5 +27,18 @@ int cli_merge(const std::vector<std::string>& args) {
     std::cout << "hexrefine merge: " << merged.size() << " records to " << a.positional[0] << "\n";
   return 0;
 }
+
+}  // namespace
+
+const CliCommand cli_merge_command = {
+    "merge",
+    "OUT.jsonl IN.jsonl [IN.jsonl ...]",
+    "Merges JSONL record files (one record per key, later files win), sorted by case and method.",
+    {
+        {"--quiet", "", "no summary line"},
+    },
+    "",
+    merge_run,
+};
 
 }  // namespace hexrefine

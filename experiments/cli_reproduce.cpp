@@ -29,9 +29,9 @@ std::string shell_quote(const std::string& s) {
 /// file, runs it and regenerates tables and plots with experiments/plots.py. The full suite goes
 /// to results/, the quick one (sweeps up to n = 30) to results/quick/, so one never overwrites
 /// the other.
-int cli_reproduce(const std::vector<std::string>& args) {
-  const CliArgs a =
-      cli_parse("reproduce", args, {}, {"--quick", "--resume", "--quiet", "--no-plots"});
+namespace {
+
+int reproduce_run(const CliArgs& a) {
   if (!a.positional.empty())
     throw InputError("hexrefine reproduce: unexpected argument '" + a.positional[0] + "'");
   const bool quick = a.flag("--quick");
@@ -74,5 +74,21 @@ int cli_reproduce(const std::vector<std::string>& args) {
                          "); the records are in " + s.output + ", rerun: " + cmd);
   return 0;
 }
+
+}  // namespace
+
+const CliCommand cli_reproduce_command = {
+    "reproduce",
+    "",
+    "Runs the thesis suite and regenerates results/ (tables, plots, records).",
+    {
+        {"--quick", "", "stop the G-2 and G-3 sweeps at n = 30 and write results/quick/"},
+        {"--resume", "", "keep the records already written"},
+        {"--quiet", "", "no progress lines"},
+        {"--no-plots", "", "records only: skip experiments/plots.py"},
+    },
+    "",
+    reproduce_run,
+};
 
 }  // namespace hexrefine

@@ -28,8 +28,9 @@ int run_summary_report(const std::string& command, const RunSummary& s, bool qui
 
 }  // namespace
 
-int cli_run(const std::vector<std::string>& args) {
-  const CliArgs a = cli_parse("run", args, {"--shard", "--output"}, {"--resume", "--quiet"});
+namespace {
+
+int run_run(const CliArgs& a) {
   if (a.positional.size() != 1)
     throw InputError(
         "hexrefine run: expected one case file (usage: hexrefine run CASES.json "
@@ -49,5 +50,21 @@ int cli_run(const std::vector<std::string>& args) {
   const RunSummary s = run_plan_execute(plan, settings, case_execute);
   return run_summary_report("run", s, settings.quiet);
 }
+
+}  // namespace
+
+const CliCommand cli_run_command = {
+    "run",
+    "CASES.json",
+    "Runs a case file: every (case, method) through the refinement pipeline, one JSON record each.",
+    {
+        {"--resume", "", "keep the records already in the output and run the rest"},
+        {"--quiet", "", "no progress lines"},
+        {"--shard", "K/N", "run only the cases i with i % N == K - 1 (1 <= K <= N)"},
+        {"--output", "OUT.jsonl", "records to this file instead of the case file's \"output\""},
+    },
+    "",
+    run_run,
+};
 
 }  // namespace hexrefine

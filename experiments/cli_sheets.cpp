@@ -79,8 +79,9 @@ nlohmann::ordered_json sheets_report(const std::string& path, const HexMesh& mes
 
 }  // namespace
 
-int cli_sheets(const std::vector<std::string>& args) {
-  const CliArgs a = cli_parse("sheets", args, {"--report"}, {});
+namespace {
+
+int sheets_run(const CliArgs& a) {
   if (a.positional.size() != 1)
     throw InputError(
         "hexrefine sheets: expected one mesh file (usage: hexrefine sheets MESH "
@@ -98,5 +99,18 @@ int cli_sheets(const std::vector<std::string>& args) {
   }
   return 0;
 }
+
+}  // namespace
+
+const CliCommand cli_sheets_command = {
+    "sheets",
+    "MESH",
+    "Lists the dual sheets (twist planes) and chords of a mesh.",
+    {
+        {"--report", "R.json", "write every sheet and chord count as JSON"},
+    },
+    "",
+    sheets_run,
+};
 
 }  // namespace hexrefine

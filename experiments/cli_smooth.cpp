@@ -23,8 +23,9 @@
 
 namespace hexrefine {
 
-int cli_smooth(const std::vector<std::string>& args) {
-  const CliArgs a = cli_parse("smooth", args, {"--method", "--region", "--sweeps", "--report"}, {});
+namespace {
+
+int smooth_run(const CliArgs& a) {
   if (a.positional.size() != 2)
     throw InputError("hexrefine smooth: expected IN OUT (two paths), got " +
                      std::to_string(a.positional.size()) + " arguments");
@@ -69,12 +70,12 @@ int cli_smooth(const std::vector<std::string>& args) {
   if (!warning.empty()) std::cerr << "warning: " << warning << "\n";
   std::cout << "smoothed " << in << " -> " << out << " (" << smooth_method_name(options.method)
             << "): min scaled Jacobian " << stats.min_scaled_jacobian_before << " -> "
-            << stats.min_scaled_jacobian_after << ", mean " << stats.mean_before << " -> "
-            << stats.mean_after << ", " << stats.sweeps << " sweeps, " << stats.nodes_moved
-            << " nodes moved\n";
+            << stats.min_scaled_jacobian_after << ", mean " << stats.mean_scaled_jacobian_before
+            << " -> " << stats.mean_scaled_jacobian_after << ", " << stats.sweeps << " sweeps, "
+            << stats.nodes_moved << " nodes moved\n";
 
   if (report_path) {
-    nlohmann::json report = smooth_stats_to_json(stats);
+    nlohmann::json report = stats;
     report["command"] = "smooth";
     report["input"] = in;
     report["output"] = out;
@@ -90,5 +91,21 @@ int cli_smooth(const std::vector<std::string>& args) {
   }
   return 0;
 }
+
+}  // namespace
+
+const CliCommand cli_smooth_command = {
+    "smooth",
+    "IN OUT",
+    "Smooths a hex mesh (the minimum scaled Jacobian never drops, no hex inverts).",
+    {
+        {"--method", "M", "laplacian or optimize (default optimize)"},
+        {"--region", "SPEC", "move only the nodes of these hexes (selection specs, united)", true},
+        {"--sweeps", "N", "at most N sweeps, 0..1000000 (default 20)"},
+        {"--report", "R.json", "write the JSON report"},
+    },
+    "",
+    smooth_run,
+};
 
 }  // namespace hexrefine

@@ -53,7 +53,28 @@ def read_records(path):
             if number == len(lines):
                 continue  # no final newline: cut short
             fail("%s:%d: not a JSON record" % (path, number))
-    return records
+    return [record_view(r) for r in records]
+
+
+def record_view(r):
+    """The fields the tables read, lifted out of a record's report (algorithms/pipeline.hpp:
+    "refine" RefineStats, "check" the refined mesh's checker report, "smoothing" {"stats",
+    "check"}; "input" the runner's description of the input). Error records keep "error"."""
+    v = dict(r)
+    if "hexes" in r.get("input", {}):
+        v["initial_hexes"] = r["input"]["hexes"]
+    refine, check = r.get("refine", {}), r.get("check", {})
+    for key in ("final_hexes", "time_seconds", "directional_hexes", "doublets_resolved",
+                "hexes_per_template"):
+        if key in refine:
+            v[key] = refine[key]
+    for key in ("conformal", "inverted_hexes", "non_conformal_faces", "min_scaled_jacobian",
+                "scaled_jacobian_histogram"):
+        if key in check:
+            v[key] = check[key]
+    if "smoothing" in r:
+        v["smoothed_min_scaled_jacobian"] = r["smoothing"]["check"]["min_scaled_jacobian"]
+    return v
 
 
 def savefig_atomic(fig, path, dpi):

@@ -20,6 +20,7 @@
 
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
+#include "mesh/generators.hpp"
 
 namespace hexrefine {
 
@@ -68,10 +69,6 @@ int64_t schema_int(const json& j, const SchemaPath& p, int64_t min_value) {
   return j.get<int64_t>();
 }
 
-void schema_number(const json& j, const SchemaPath& p) {
-  if (!j.is_number() || !std::isfinite(j.get<double>())) p.fail("expected a finite number");
-}
-
 bool schema_bool(const json& j, const SchemaPath& p) {
   if (!j.is_boolean()) p.fail("expected true or false");
   return j.get<bool>();
@@ -82,49 +79,6 @@ std::vector<std::string> schema_strings(const json& j, const SchemaPath& p) {
   std::vector<std::string> out;
   for (size_t i = 0; i < j.size(); ++i) out.push_back(schema_string(j[i], p.at(i)));
   return out;
-}
-
-/// Parameter kinds of the generators (the fields of their parameter structs).
-enum class ParamKind { integer, number, int3, number3 };
-
-const std::map<std::string, std::map<std::string, ParamKind>>& generator_parameters() {
-  using K = ParamKind;
-  static const std::map<std::string, std::map<std::string, ParamKind>> table = {
-      {"brick",
-       {{"dims", K::int3}, {"size", K::number3}, {"jitter", K::number}, {"seed", K::integer}}},
-      {"gear",
-       {{"teeth", K::integer},
-        {"inner_radius", K::number},
-        {"root_radius", K::number},
-        {"tip_radius", K::number},
-        {"thickness", K::number},
-        {"layers", K::integer},
-        {"body_radial", K::integer},
-        {"tooth_radial", K::integer},
-        {"tooth_tangential", K::integer},
-        {"gap_tangential", K::integer},
-        {"tip_fraction", K::number}}},
-      {"cylinder",
-       {{"radius", K::number},
-        {"height", K::number},
-        {"square_intervals", K::integer},
-        {"radial_intervals", K::integer},
-        {"layers", K::integer},
-        {"core", K::number}}},
-      {"twisted-ring",
-       {{"ring_radius", K::number},
-        {"section_size", K::number},
-        {"around", K::integer},
-        {"section_intervals", K::integer}}},
-      {"stepped",
-       {{"steps", K::integer},
-        {"step_layers", K::integer},
-        {"depth", K::integer},
-        {"top_width", K::integer},
-        {"tread", K::integer},
-        {"cell", K::number}}},
-  };
-  return table;
 }
 
 json parse_mesh(const json& j, const SchemaPath& p, const std::string& base_dir) {
@@ -141,43 +95,17 @@ json parse_mesh(const json& j, const SchemaPath& p, const std::string& base_dir)
     if (!fs::is_regular_file(path, ec)) p.at("file").fail("mesh file not found: " + path.string());
     return json{{"file", given}, {"path", path.lexically_normal().string()}};
   }
-  std::string kind = schema_string(j["generate"], p.at("generate"));
-  if (kind == "twisted_ring") kind = "twisted-ring";
-  const auto& table = generator_parameters();
-  const auto it = table.find(kind);
-  if (it == table.end())
-    p.at("generate")
-        .fail("unknown generator '" + kind +
-              "' (expected brick, gear, cylinder, twisted-ring or stepped)");
-  json out = json::object();
-  out["generate"] = kind;
-  for (const auto& [key, value] : j.items()) {
-    if (key == "generate") continue;
-    const auto param = it->second.find(key);
-    if (param == it->second.end()) {
-      std::string list;
-      for (const auto& [name, k] : it->second) list += (list.empty() ? "" : ", ") + name;
-      p.at(key).fail("unknown parameter of generator '" + kind + "' (expected one of: " + list +
-                     ")");
-    }
-    switch (param->second) {
-      case ParamKind::integer:
-        schema_int(value, p.at(key), 0);
-        break;
-      case ParamKind::number:
-        schema_number(value, p.at(key));
-        break;
-      case ParamKind::int3:
-        if (!value.is_array() || value.size() != 3) p.at(key).fail("expected 3 integers");
-        for (size_t i = 0; i < 3; ++i) schema_int(value[i], p.at(key).at(i), 1);
-        break;
-      case ParamKind::number3:
-        if (!value.is_array() || value.size() != 3) p.at(key).fail("expected 3 numbers");
-        for (size_t i = 0; i < 3; ++i) schema_number(value[i], p.at(key).at(i));
-        break;
-    }
-    out[key] = value;
+  const std::string kind = schema_string(j["generate"], p.at("generate"));
+  const Generator* generator = nullptr;
+  try {
+    generator = &generator_find(kind);
+  } catch (const InputError& e) {
+    p.at("generate").fail(e.what());
   }
+  json given = j;
+  given.erase("generate");
+  json out = generator_params(*generator, given, p.file + ": " + (p.path.empty() ? "" : p.path));
+  out["generate"] = generator->name;
   return out;
 }
 
@@ -206,9 +134,11 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
     c.methods = schema_strings(j["methods"], p.at("methods"));
     std::set<std::string> seen;
     for (size_t i = 0; i < c.methods.size(); ++i) {
-      if (c.methods[i] != "selective" && c.methods[i] != "sheet")
-        p.at("methods").at(i).fail("unknown method '" + c.methods[i] +
-                                   "' (expected selective or sheet)");
+      try {
+        refine_method(c.methods[i]);
+      } catch (const InputError& e) {
+        p.at("methods").at(i).fail(e.what());
+      }
       if (!seen.insert(c.methods[i]).second)
         p.at("methods").at(i).fail("method '" + c.methods[i] + "' listed twice");
     }
@@ -224,7 +154,8 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
     const json& o = j["options"];
     const SchemaPath op = p.at("options");
     schema_require_object(o, op);
-    schema_allow_keys(o, op, {"ranking", "propagation", "ebe_only", "buffer", "allow_inverted"});
+    schema_allow_keys(
+        o, op, {"ranking", "propagation", "ebe_only", "buffer", "allow_inverted", "placement"});
     if (o.contains("ranking")) c.options.ranking = schema_bool(o["ranking"], op.at("ranking"));
     if (o.contains("propagation"))
       c.options.propagation = schema_bool(o["propagation"], op.at("propagation"));
@@ -232,6 +163,15 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
     if (o.contains("buffer")) c.options.buffer = schema_bool(o["buffer"], op.at("buffer"));
     if (o.contains("allow_inverted"))
       c.options.allow_inverted = schema_bool(o["allow_inverted"], op.at("allow_inverted"));
+    if (o.contains("placement")) {
+      const std::string placement = schema_string(o["placement"], op.at("placement"));
+      if (placement == "trilinear")
+        c.options.placement.method = PlacementMethod::trilinear;
+      else if (placement == "optimized")
+        c.options.placement.method = PlacementMethod::optimized;
+      else
+        op.at("placement").fail("expected \"trilinear\" or \"optimized\"");
+    }
   }
   if (j.contains("tags")) {
     schema_require_object(j["tags"], p.at("tags"));
@@ -299,10 +239,10 @@ RunPlan run_plan_read(const std::string& path) {
 }
 
 json run_options_to_json(const RefineOptions& o, bool smooth) {
-  return json{{"ranking", o.ranking},   {"propagation", o.propagation},
-              {"ebe_only", o.ebe_only}, {"passes", o.passes},
-              {"buffer", o.buffer},     {"allow_inverted", o.allow_inverted},
-              {"smooth", smooth}};
+  json j = o;
+  j.erase("threads");  // the output does not depend on it
+  j["smooth"] = smooth;
+  return j;
 }
 
 std::string run_record_key(const std::string& case_name, const std::string& method,
@@ -576,16 +516,6 @@ std::string run_mesh_file_name(const std::string& case_name, const std::string& 
   for (char& ch : name)
     if (ch == '/' || ch == '\\' || ch == ' ' || ch == ':') ch = '_';
   return name + "." + method + ".vtu";
-}
-
-std::vector<int64_t> scaled_jacobian_histogram(const std::vector<double>& values) {
-  std::vector<int64_t> bins(20, 0);
-  for (double v : values) {
-    if (std::isnan(v)) v = -1.0;
-    const int b = static_cast<int>(std::floor((v + 1.0) / 0.1 + 1e-9));
-    ++bins[std::clamp(b, 0, 19)];
-  }
-  return bins;
 }
 
 // --- the run ----------------------------------------------------------------------------------

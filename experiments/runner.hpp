@@ -12,7 +12,8 @@
 ///               "m.mesh"}, "select": ["boundary:-1,0,0", ...], "methods": ["selective", "sheet"],
 ///               "passes": 1, "smooth": false, "save_mesh": false,
 ///               "options": {"ranking": true, "propagation": true, "ebe_only": false,
-///                           "buffer": false, "allow_inverted": false},
+///                           "buffer": false, "allow_inverted": false,
+///                           "placement": "optimized" | "trilinear"},
 ///               "tags": {...}}],           // optional, copied into every record
 ///    "output": "path.jsonl"}
 /// Relative paths (mesh files, output) are relative to the case file's folder.
@@ -62,8 +63,9 @@ RunPlan run_plan_parse(const nlohmann::json& root, const std::string& file,
 /// Reads and parses a case file (syntax errors: InputError with the file, line and column).
 RunPlan run_plan_read(const std::string& path);
 
-/// The options of a record as JSON: every RefineOptions field plus "smooth", defaults filled
-/// in, so {} and {"ranking": true} give the same object (and the same record key).
+/// The options of a record as JSON: every RefineOptions field but threads (the output does not
+/// depend on it) plus "smooth", defaults filled in, so {} and {"ranking": true} give the same
+/// object (and the same record key).
 nlohmann::json run_options_to_json(const RefineOptions& options, bool smooth);
 
 /// The key that identifies a record: case name, method and the dumped options object
@@ -161,15 +163,11 @@ struct RunSummary {
 RunSummary run_plan_execute(const RunPlan& plan, const RunSettings& settings,
                             const RunExecutor& execute);
 
-/// The real executor: builds or reads the mesh, selects the targets, runs each method, checks
-/// the output (conformity, inverted hexes), measures scaled Jacobians, smooths if asked, and
-/// with save_mesh writes save_mesh_dir/run_mesh_file_name(case, method) (record: "mesh_file").
+/// The real executor: builds or reads the mesh, then runs each method through the refinement
+/// pipeline (algorithms/pipeline.hpp); the record is its report plus the input's description,
+/// wall and CPU seconds, and with save_mesh the file save_mesh_dir/run_mesh_file_name(case,
+/// method) (record: "mesh_file"). A refusal (OperationError) is a record with "error".
 void case_execute(const RunCase& c, const std::vector<std::string>& methods, const RunEmit& emit);
-
-/// Scaled Jacobian histogram bins: 20 bins of width 0.1 over [-1, 1]; bin b holds values in
-/// [-1 + 0.1 b, -1 + 0.1 (b + 1)), the last bin also holds 1.0. Values outside [-1, 1] are
-/// clamped into the end bins.
-std::vector<int64_t> scaled_jacobian_histogram(const std::vector<double>& values);
 
 /// "G-3/n=20", "selective" -> "G-3_n=20.selective.vtu": case names may hold '/'.
 std::string run_mesh_file_name(const std::string& case_name, const std::string& method);

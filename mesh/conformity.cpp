@@ -284,6 +284,12 @@ int64_t count_duplicate_nodes(const HexMesh& mesh) {
   return std::count(duplicate.begin(), duplicate.end(), 1);
 }
 
+/// Bin of scaled_jacobian_histogram.
+int scaled_jacobian_bin(double v) {
+  if (std::isnan(v)) v = -1.0;
+  return std::clamp(static_cast<int>(std::floor((v + 1.0) / 0.1 + 1e-9)), 0, 19);
+}
+
 }  // namespace
 
 MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
@@ -306,18 +312,26 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
   r.nonmanifold_faces = static_cast<int64_t>(t.nonmanifold_faces.size());
 
   // Quality and volume.
+  std::vector<int32_t> defects;  // hexes with a defect (a few, for messages)
+  auto defect = [&](int32_t h) {
+    if (defects.size() < 4 * mesh_check_defect_hex_limit) defects.push_back(h);
+  };
   double sum_scaled_jacobian = 0.0;
+  r.scaled_jacobian_histogram.assign(20, 0);
   for (int32_t h = 0; h < mesh.hex_count(); ++h) {
     const HexCorners p = hex_points(mesh, h);
     const double sj = hex_scaled_jacobian(p);
     sum_scaled_jacobian += sj;
     r.min_scaled_jacobian = std::min(r.min_scaled_jacobian, sj);
     r.volume += hex_volume(p);
+    ++r.scaled_jacobian_histogram[scaled_jacobian_bin(sj)];
     if (sj <= 0.0) {
       if (r.inverted_hexes == 0) r.first_inverted_hex = h;
       ++r.inverted_hexes;
+      defect(h);
     }
   }
+  for (int32_t f : t.nonmanifold_faces) defect(t.face_hexes[f][0]);
   if (r.hexes > 0) r.mean_scaled_jacobian = sum_scaled_jacobian / static_cast<double>(r.hexes);
 
   // Doublets: a neighbour met across two local faces of the same hex.
@@ -330,7 +344,10 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
       bool seen_before = false, repeated = false;
       for (int b = 0; b < 6; ++b)
         if (b != a && neighbours[b] == g) (b < a ? seen_before : repeated) = true;
-      if (repeated && !seen_before) ++r.doublets;
+      if (repeated && !seen_before) {
+        ++r.doublets;
+        defect(h);
+      }
     }
   }
 
@@ -397,6 +414,11 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
     }
   }
   r.non_conformal_faces = static_cast<int64_t>(non_conformal.size());
+  for (int32_t i : non_conformal) defect(t.face_hexes[surface.faces[i]][0]);
+  std::sort(defects.begin(), defects.end());
+  defects.erase(std::unique(defects.begin(), defects.end()), defects.end());
+  if (defects.size() > mesh_check_defect_hex_limit) defects.resize(mesh_check_defect_hex_limit);
+  r.defect_hexes = std::move(defects);
 
   // Hanging nodes: T-junctions among the non-conformal faces.
   if (!non_conformal.empty()) {
@@ -431,8 +453,8 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
   return r;
 }
 
-nlohmann::json mesh_check_to_json(const MeshCheckReport& r) {
-  nlohmann::json j;
+void to_json(nlohmann::json& j, const MeshCheckReport& r) {
+  j = nlohmann::json::object();
   j["hexes"] = r.hexes;
   j["nodes"] = r.nodes;
   j["conformal"] = r.conformal;
@@ -451,6 +473,9 @@ nlohmann::json mesh_check_to_json(const MeshCheckReport& r) {
   j["mean_scaled_jacobian"] = r.mean_scaled_jacobian;
   j["volume"] = r.volume;
   j["boundary_area"] = r.boundary_area;
+  j["defect_hexes"] = r.defect_hexes;
+  j["scaled_jacobian_histogram"] = {
+      {"bin_edges_from", -1.0}, {"bin_width", 0.1}, {"counts", r.scaled_jacobian_histogram}};
   j["reference_compared"] = r.reference_compared;
   if (r.reference_compared) {
     j["reference_planar_faced"] = r.reference_planar_faced;
@@ -460,7 +485,12 @@ nlohmann::json mesh_check_to_json(const MeshCheckReport& r) {
     j["boundary_area_relative_error"] = r.boundary_area_relative_error;
     j["geometry_preserved"] = r.geometry_preserved;
   }
-  return j;
+}
+
+std::vector<int64_t> scaled_jacobian_histogram(const std::vector<double>& values) {
+  std::vector<int64_t> bins(20, 0);
+  for (double v : values) ++bins[scaled_jacobian_bin(v)];
+  return bins;
 }
 
 std::vector<std::string> mesh_check_defects(const MeshCheckReport& r) {

@@ -75,6 +75,11 @@ struct MeshCheckReport {
   double volume = 0.0, boundary_area = 0.0;
   /// Lowest id of an inverted hex, -1 if none.
   int32_t first_inverted_hex = -1;
+  /// The lowest ids (at most mesh_check_defect_hex_limit) of hexes with a defect: inverted, on a
+  /// non-conformal or non-manifold face, or in a doublet; ascending.
+  std::vector<int32_t> defect_hexes;
+  /// Scaled Jacobians in 20 bins of width 0.1 over [-1, 1] (mesh_scaled_jacobian_histogram).
+  std::vector<int64_t> scaled_jacobian_histogram;
 
   /// Reference comparison (meaningful only when reference_compared).
   bool reference_compared = false;
@@ -90,12 +95,21 @@ struct MeshCheckReport {
   bool valid() const { return conformal && inverted_hexes == 0 && geometry_preserved; }
 };
 
+/// How many defect hexes a report lists.
+inline constexpr size_t mesh_check_defect_hex_limit = 20;
+
 /// Checks `mesh` (and compares it with `reference`, the mesh before refinement, if given).
 /// Throws InputError naming the hex if a node id is out of range or repeated within a hex.
 MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference = nullptr);
 
-/// All fields of the report under their own names, plus "valid".
-nlohmann::json mesh_check_to_json(const MeshCheckReport& report);
+/// All fields of the report under their own names, plus "valid" (the reference fields only when
+/// reference_compared).
+void to_json(nlohmann::json& j, const MeshCheckReport& report);
+
+/// Scaled Jacobian histogram: 20 bins of width 0.1 over [-1, 1]; bin b holds values in
+/// [-1 + 0.1 b, -1 + 0.1 (b + 1)), the last bin also holds 1.0. Values outside [-1, 1] (and NaN,
+/// counted as -1) are clamped into the end bins.
+std::vector<int64_t> scaled_jacobian_histogram(const std::vector<double>& values);
 
 /// One line per defect found ("76 inverted hexes, first at id 3"), empty if none.
 std::vector<std::string> mesh_check_defects(const MeshCheckReport& report);

@@ -52,7 +52,7 @@ struct DisjointSets {
 
 }  // namespace
 
-DualSheets dual_build(const HexMesh& mesh, const HexTopology& t) {
+DualSheets dual_build(const HexMesh& mesh, const HexTopology& t, DualParts parts) {
   DualSheets d;
   const int32_t nh = mesh.hex_count();
 
@@ -68,6 +68,22 @@ DualSheets dual_build(const HexMesh& mesh, const HexTopology& t) {
   for (int32_t e = 0; e < t.edge_count(); ++e) ++d.sheets[d.edge_sheet[e]].edge_count;
 
   d.hex_sheet.resize(nh);
+  if (parts == DualParts::sheets) {
+    for (int32_t h = 0; h < nh; ++h) {
+      auto& hs = d.hex_sheet[h];
+      for (int axis = 0; axis < 3; ++axis)
+        hs[axis] = d.edge_sheet[t.hex_edge_ids[h][hex_axis_edges[axis][0]]];
+      for (int axis = 0; axis < 3; ++axis) {
+        bool seen_before = false;
+        for (int b = 0; b < axis; ++b) seen_before |= hs[b] == hs[axis];
+        if (seen_before)
+          d.sheets[hs[axis]].self_intersecting = true;
+        else
+          ++d.sheets[hs[axis]].hex_count;
+      }
+    }
+    return d;
+  }
   d.sheet_hex_offsets.assign(static_cast<size_t>(sheet_count) + 1, 0);
   for (int32_t h = 0; h < nh; ++h) {
     auto& hs = d.hex_sheet[h];
@@ -125,6 +141,41 @@ DualSheets dual_build(const HexMesh& mesh, const HexTopology& t) {
     for (int le : hex_face_edges[lf]) d.sheets[d.edge_sheet[t.hex_edge_ids[h][le]]].closed = false;
   }
   return d;
+}
+
+SheetPieces dual_sheet_pieces(const HexTopology& t, std::span<const int32_t> hexes,
+                              std::span<const uint16_t> edge_masks) {
+  DisjointSets edges(t.edge_count());
+  for (size_t i = 0; i < hexes.size(); ++i)
+    for (int axis = 0; axis < 3; ++axis) {
+      int32_t first = -1;
+      for (int e : hex_axis_edges[axis]) {
+        if (!(edge_masks[i] & (1u << e))) continue;
+        const int32_t id = t.hex_edge_ids[hexes[i]][e];
+        if (first < 0)
+          first = id;
+        else
+          edges.unite(first, id);
+      }
+    }
+  SheetPieces out;
+  out.hex_piece.resize(hexes.size());
+  std::vector<int32_t> piece_of_root(t.edge_count(), -1);
+  for (size_t i = 0; i < hexes.size(); ++i)
+    for (int axis = 0; axis < 3; ++axis) {
+      out.hex_piece[i][axis] = -1;
+      for (int e : hex_axis_edges[axis]) {
+        if (!(edge_masks[i] & (1u << e))) continue;
+        const int32_t root = edges.find(t.hex_edge_ids[hexes[i]][e]);
+        if (piece_of_root[root] < 0) {
+          piece_of_root[root] = out.piece_count();
+          out.piece_edge.push_back(root);  // union by lower id: the root is the lowest edge
+        }
+        out.hex_piece[i][axis] = piece_of_root[root];
+        break;
+      }
+    }
+  return out;
 }
 
 }  // namespace hexrefine

@@ -56,9 +56,29 @@ struct DualSheets {
   int32_t chord_count() const { return static_cast<int32_t>(chords.size()); }
 };
 
+/// Which parts dual_build fills.
+enum class DualParts : uint8_t {
+  all,     ///< everything
+  sheets,  ///< edge_sheet, hex_sheet and sheets only (no sheet -> hex CSR, no chords)
+};
+
 /// Builds sheets and chords in linear time (union-find with path halving over flat arrays).
 /// Precondition: `topology` was built from `mesh`.
-DualSheets dual_build(const HexMesh& mesh, const HexTopology& topology);
+DualSheets dual_build(const HexMesh& mesh, const HexTopology& topology,
+                      DualParts parts = DualParts::all);
+
+/// Pieces of dual sheets inside a part of the mesh: for every hex hexes[i] and axis k, the edges
+/// of axis k whose bits are set in edge_masks[i] (bit e: local edge e) join one class, and
+/// classes that share an edge are one piece. hex_piece[i][k] is the piece of those edges (-1 if
+/// none is set), pieces numbered in order of first appearance over (i, k); piece_edge[p] is the
+/// lowest edge id of piece p. Time linear in the edge count plus the part's size.
+struct SheetPieces {
+  std::vector<std::array<int32_t, 3>> hex_piece;
+  std::vector<int32_t> piece_edge;
+  int32_t piece_count() const { return static_cast<int32_t>(piece_edge.size()); }
+};
+SheetPieces dual_sheet_pieces(const HexTopology& topology, std::span<const int32_t> hexes,
+                              std::span<const uint16_t> edge_masks);
 
 /// Sheet id of edge `edge` (in [0, edge count)).
 inline int32_t sheet_of_edge(const DualSheets& d, int32_t edge) {

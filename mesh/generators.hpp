@@ -13,6 +13,10 @@
 
 #include <array>
 #include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "mesh/hex_mesh.hpp"
 
@@ -133,5 +137,51 @@ struct SteppedParams {
 };
 
 HexMesh generate_stepped(const SteppedParams& params);
+
+// The parameter structs as JSON (case files, reports): every field under its own name, missing
+// fields keep their defaults.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(BrickParams, dims, size, jitter, seed)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GearParams, teeth, inner_radius, root_radius,
+                                                tip_radius, thickness, layers, body_radial,
+                                                tooth_radial, tooth_tangential, gap_tangential,
+                                                tip_fraction)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(CylinderParams, radius, height, square_intervals,
+                                                radial_intervals, layers, core)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TwistedRingParams, ring_radius, section_size,
+                                                around, section_intervals)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SteppedParams, steps, step_layers, depth, top_width,
+                                                tread, cell)
+
+/// One parameter of a generator as the front ends see it: the CLI's `generate` option
+/// (--name, '_' written '-') and the case files' "mesh" key.
+struct GeneratorField {
+  std::string name;  ///< the parameter struct's field
+  std::string help;  ///< meaning and range
+};
+
+/// A generator for the front ends: its parameters in one table, built from its parameter
+/// struct (the JSON conversion above gives each field's kind and default).
+struct Generator {
+  std::string name;  ///< "brick", "gear", "cylinder", "twisted-ring", "stepped"
+  std::string description;
+  std::vector<GeneratorField> fields;
+  nlohmann::json defaults;  ///< the parameter struct's defaults as JSON
+  /// Builds the mesh from complete, kind-checked parameters (generator_params).
+  HexMesh (*generate)(const nlohmann::json& params);
+};
+
+/// Every generator, in a fixed order.
+const std::vector<Generator>& generators();
+
+/// The generator called `name` ("twisted_ring" is accepted for "twisted-ring"); InputError
+/// listing the known names otherwise.
+const Generator& generator_find(std::string_view name);
+
+/// Checks `given` (an object of parameter name -> value) against the generator's fields: every
+/// key a field, every value of the field's kind (an integer, >= 0 where the default is unsigned;
+/// a number; three integers; three numbers). Returns the complete parameters (defaults filled
+/// in). Throws InputError "`where`/key: what was expected". Ranges are checked by the generator.
+nlohmann::json generator_params(const Generator& generator, const nlohmann::json& given,
+                                const std::string& where);
 
 }  // namespace hexrefine

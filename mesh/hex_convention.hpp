@@ -117,6 +117,22 @@ inline constexpr int hex_vertex_edges[8][3] = {
     {6, 7, 11},  // v7
 };
 
+/// Local vertex at corner (x, y, z) of the reference cube, each coordinate 0 or 1.
+constexpr int hex_vertex_at(int x, int y, int z) {
+  for (int v = 0; v < 8; ++v)
+    if (hex_corner[v][0] == x && hex_corner[v][1] == y && hex_corner[v][2] == z) return v;
+  return -1;
+}
+
+/// Local edge joining local vertices a and b (either order), or -1 if they are not adjacent.
+constexpr int hex_edge_joining(int a, int b) {
+  for (int e = 0; e < 12; ++e)
+    if ((hex_edges[e][0] == a && hex_edges[e][1] == b) ||
+        (hex_edges[e][0] == b && hex_edges[e][1] == a))
+      return e;
+  return -1;
+}
+
 namespace convention_detail {
 constexpr bool face_has_vertex(int f, int v) {
   for (int i = 0; i < 4; ++i)
@@ -185,5 +201,6 @@ static_assert(convention_detail::edges_well_formed(), "edge table disagrees with
 static_assert(convention_detail::faces_well_formed(), "face table not outward or edges mismatched");
 static_assert(convention_detail::opposite_faces_disjoint(), "opposite faces must share no vertex");
 static_assert(convention_detail::vertex_edges_well_formed(), "vertex-edge table wrong");
+static_assert(hex_vertex_at(1, 1, 1) == 6 && hex_edge_joining(3, 7) == 11, "lookups wrong");
 
 }  // namespace hexrefine

@@ -25,6 +25,9 @@ struct HexAttribute {
 inline constexpr std::string_view attribute_block_id = "block_id";
 inline constexpr std::string_view attribute_template_tag = "template_tag";
 inline constexpr std::string_view attribute_refinement_level = "refinement_level";
+/// The input hex each output hex of a refinement came from (untouched hexes: their own id), so
+/// fields and materials map from parents to children.
+inline constexpr std::string_view attribute_parent_hex = "parent_hex";
 
 /// An all-hexahedral mesh. `hexes[h][i]` indexes `points`; vertex order as in hex_convention.hpp.
 /// Invariant (checked by mesh_validate_ids): every id in [0, points.size()), every attribute has

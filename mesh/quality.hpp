@@ -28,6 +28,25 @@ namespace hexrefine {
 /// The 8 corners of one hex, vertex order of hex_convention.hpp.
 using HexCorners = std::array<Eigen::Vector3d, 8>;
 
+/// Corner Jacobian at local vertex v (0..7): the 3x3 matrix whose column k is the edge of
+/// hex_vertex_edges[v][k], from its lower to its higher corner (the Jacobian of the trilinear map
+/// at that corner). Identity for the unit cube; det > 0 at every corner of a valid hex.
+Eigen::Matrix3d hex_corner_jacobian(const HexCorners& p, int v);
+
+/// Centre Jacobian: column k is the mean of the four edges along axis k (the Jacobian of the
+/// trilinear map at the centre of the reference cube). Identity for the unit cube.
+Eigen::Matrix3d hex_centre_jacobian(const HexCorners& p);
+
+/// True if det(hex_corner_jacobian(p, v)) > 0 at all eight corners (no NaN passes). Unit cube:
+/// true; a hex with a corner folded flat or inside out: false. The test the refiners and the
+/// smoother use to keep a hex valid; hex_scaled_jacobian(p) > 0 implies it.
+bool hex_corners_positive(const HexCorners& p);
+
+/// The nine samples whose minimum is hex_scaled_jacobian, in `out`: corners 0..7, then the
+/// centre, each det(A) / (|a1| |a2| |a3|) clamped to [-1, 1] (0 for a zero-length column).
+/// Unit cube: nine ones.
+void hex_scaled_jacobian_samples(const HexCorners& p, std::array<double, 9>& out);
+
 /// Value returned by unbounded metrics (condition, edge ratio) for degenerate hexes, as Verdict's
 /// VERDICT_DBL_MAX; finite so JSON reports stay valid.
 inline constexpr double hex_metric_max = 1e30;

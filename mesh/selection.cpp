@@ -172,4 +172,11 @@ Selection select_hexes(const HexMesh& mesh, const HexTopology& t,
   return out;
 }
 
+Selection select_hexes(const HexMesh& mesh, const std::vector<std::string>& specs) {
+  bool faces = false;
+  for (const std::string& spec : specs) faces = faces || spec.rfind("boundary:", 0) == 0;
+  return select_hexes(mesh, faces ? topology_build(mesh, TopologyParts::faces) : HexTopology{},
+                      specs);
+}
+
 }  // namespace hexrefine

@@ -37,4 +37,7 @@ struct Selection {
 Selection select_hexes(const HexMesh& mesh, const HexTopology& topology,
                        const std::vector<std::string>& specs);
 
+/// As above; the faces are built (TopologyParts::faces) only when a `boundary:` spec needs them.
+Selection select_hexes(const HexMesh& mesh, const std::vector<std::string>& specs);
+
 }  // namespace hexrefine

@@ -7,30 +7,103 @@
 
 #include "algorithms/selective.hpp"
 #include "algorithms/sheet.hpp"
+#include "mesh/error.hpp"
 #include "mesh/generators.hpp"
 #include "mesh/hex_mesh.hpp"
 
 namespace hexrefine {
 namespace {
 
-TEST(Refiner, TemplateNamesAreDistinct) {
-  std::set<std::string> names;
-  for (int t = 0; t <= static_cast<int>(TemplateTag::sheet); ++t)
-    names.insert(template_tag_name(static_cast<TemplateTag>(t)));
-  EXPECT_EQ(names.size(), 10u);
-  EXPECT_STREQ(template_tag_name(TemplateTag::t1_3_adjust2), "1-3-adj2");
+TEST(Refiner, MethodsAreRegisteredOnceByName) {
+  ASSERT_EQ(refine_methods().size(), 2u);
+  EXPECT_EQ(refine_method("selective").name, "selective");
+  EXPECT_EQ(refine_method("sheet").plan, &sheet_plan);
+  EXPECT_TRUE(refine_method("selective").uses_buffer);
+  EXPECT_FALSE(refine_method("sheet").uses_buffer);
+  try {
+    refine_method("selectiv");
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("selective, sheet"), std::string::npos) << e.what();
+  }
 }
 
-TEST(Refiner, StatsToJsonCarriesEveryField) {
+TEST(Refiner, StatsAndOptionsRoundTripThroughJson) {
   RefineStats s;
   s.method = "selective";
   s.initial_hexes = 1000;
   s.final_hexes = 8060;
   s.hexes_per_template["1-27"] = 5130;
-  const nlohmann::json j = refine_stats_to_json(s);
+  s.doublets_by_rule["edge_of_three_faces"] = 2;
+  s.placement.untangled = 3;
+  const nlohmann::json j = s;
   EXPECT_EQ(j.at("final_hexes").get<int>(), 8060);
   EXPECT_EQ(j.at("hexes_per_template").at("1-27").get<int>(), 5130);
+  EXPECT_EQ(j.at("placement").at("untangled").get<int>(), 3);
   EXPECT_EQ(j.at("method").get<std::string>(), "selective");
+  EXPECT_EQ(j.get<RefineStats>().doublets_by_rule.at("edge_of_three_faces"), 2);
+  RefineOptions o;
+  o.passes = 3;
+  o.placement.method = PlacementMethod::trilinear;
+  const nlohmann::json oj = o;
+  EXPECT_EQ(oj.at("placement").at("method"), "trilinear");
+  const RefineOptions back = oj.get<RefineOptions>();
+  EXPECT_EQ(back.passes, 3);
+  EXPECT_EQ(back.placement.method, PlacementMethod::trilinear);
+  // Missing keys keep their defaults.
+  EXPECT_TRUE(nlohmann::json::object().get<RefineOptions>().ranking);
+}
+
+TEST(Refiner, RefusesBadTargetsOptionsAndInvertedInputNamingTheHexes) {
+  const HexMesh m = generate_brick({{2, 2, 2}});
+  const RefineMethod& method = refine_method("selective");
+  EXPECT_THROW(refine(method, m, {{3, 1}}, {}), InputError);  // not ascending
+  EXPECT_THROW(refine(method, m, {{1, 1}}, {}), InputError);  // repeated
+  EXPECT_THROW(refine(method, m, {{8}}, {}), InputError);     // out of range
+  RefineOptions zero;
+  zero.passes = 0;
+  EXPECT_THROW(refine(method, m, {{0}}, zero), InputError);
+  HexMesh inverted = m;
+  std::swap(inverted.points[13], inverted.points[26]);  // the centre node onto a corner's place
+  try {
+    refine(refine_method("sheet"), inverted, {{0}}, {});
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("scaled Jacobian <= 0"), std::string::npos) << what;
+    EXPECT_NE(what.find("7 ("), std::string::npos) << what;  // hex 7 and its value
+  }
+  RefineOptions allow;
+  allow.allow_inverted = true;
+  allow.placement.method = PlacementMethod::trilinear;
+  EXPECT_NO_THROW(refine(method, inverted, {{0}}, allow));
+}
+
+TEST(Refiner, ParentHexNamesTheInputHexAcrossPasses) {
+  // Two passes on one corner hex of a 2x2x2 brick: every output hex names the input hex it
+  // lies in, and an input parent_hex attribute (a refined mesh refined again) is replaced.
+  HexMesh m = generate_brick({{2, 2, 2}});
+  m.attributes.push_back({std::string(attribute_parent_hex), std::vector<int32_t>(8, 42)});
+  RefineOptions o;
+  o.passes = 2;
+  const RefineResult r = selective_refine(m, {{0}}, o);
+  const auto& parent = *mesh_find_attribute(r.mesh, attribute_parent_hex);
+  std::vector<int64_t> per_parent(8, 0);
+  for (int32_t h = 0; h < r.mesh.hex_count(); ++h) {
+    ASSERT_GE(parent[h], 0);
+    ASSERT_LT(parent[h], 8);
+    ++per_parent[parent[h]];
+    const Eigen::Vector3d c = hex_centroid(r.mesh, h);
+    const Eigen::Vector3d lo = hex_points(m, parent[h])[0];
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(c[k], lo[k]);
+      EXPECT_LE(c[k], lo[k] + 0.5);
+    }
+  }
+  EXPECT_EQ(per_parent[0], 27 * 27);
+  int64_t total = 0;
+  for (int64_t n : per_parent) total += n;
+  EXPECT_EQ(total, r.mesh.hex_count());
 }
 
 TEST(Refiner, OutputDoesNotDependOnTheThreadCount) {

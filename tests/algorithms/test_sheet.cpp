@@ -7,7 +7,7 @@
 #include <random>
 
 #include "algorithms/selective.hpp"
-#include "algorithms/templates.hpp"
+#include "algorithms/template_engine.hpp"
 #include "mesh/conformity.hpp"
 #include "mesh/dual.hpp"
 #include "mesh/error.hpp"
@@ -435,8 +435,9 @@ TEST(ExpectConformalBox, DetectsAHangingFace) {
     if (cube_symmetry_edge_mask(cube_symmetries()[i], template_split_edges(template_1_3())) ==
         edge_bits({1, 3, 5, 7}))
       across_y = static_cast<int8_t>(i);
-  const std::vector<TemplateApplication> apps = {{0, &template_1_3(), across_y}};
-  HexMesh broken = templates_apply(m, t, apps).mesh;
+  RefinementPlan plan;
+  plan.uses.push_back({HexId{0}, &template_1_3(), across_y});
+  HexMesh broken = plan_apply(m, t, plan).mesh;
   ASSERT_EQ(broken.hex_count(), 4);
   double area = 0;
   // The three slabs' faces on one side, the whole face on the other.
@@ -684,15 +685,15 @@ TEST(SheetRefine, CompositesGiveTheRoundByRoundMesh) {
 }
 
 TEST(SheetRefine, InvertedInputIsRefusedByBothPaths) {
-  // sheet_refine does not screen its input (the CLI does): an inside-out hex must still not
-  // come out as inverted children, whether the rounds run as composites or one by one.
+  // An inside-out input hex is bad input (refine_input_validate), whether the rounds run as
+  // composites or one by one; allow_inverted refines it anyway.
   HexMesh m = fixture_brick(2, 1, 1);
   for (int v = 0; v < 4; ++v) std::swap(m.hexes[1][v], m.hexes[1][v + 4]);
   Targets all{{0, 1}};
-  EXPECT_THROW(sheet_refine(m, all, {}), OperationError);
+  EXPECT_THROW(sheet_refine(m, all, {}), InputError);
   SheetControl rounds;
   rounds.composites = false;
-  EXPECT_THROW(sheet_refine(m, all, {}, rounds), OperationError);
+  EXPECT_THROW(sheet_refine(m, all, {}, rounds), InputError);
   RefineOptions allow;
   allow.allow_inverted = true;
   EXPECT_EQ(sheet_refine(m, all, allow).mesh.hex_count(), 54);

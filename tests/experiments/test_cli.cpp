@@ -2,16 +2,17 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "mesh/error.hpp"
+#include "tests/cli_runner.hpp"
 
 namespace hexrefine {
 namespace {
 
 TEST(Cli, ParsesValuesFlagsAndPositionals) {
-  const CliArgs a = cli_parse(
-      "refine",
-      {"in.mesh", "--select", "all", "out.vtk", "--select", "box:0,0,0,1,1,1", "--smooth"},
-      {"--select"}, {"--smooth"});
+  const CliArgs a = cli_parse(cli_refine_command, {"in.mesh", "--select", "all", "out.vtk",
+                                                   "--select", "box:0,0,0,1,1,1", "--smooth"});
   ASSERT_EQ(a.positional.size(), 2u);
   EXPECT_EQ(a.positional[1], "out.vtk");
   EXPECT_EQ(a.all("--select").size(), 2u);
@@ -19,9 +20,22 @@ TEST(Cli, ParsesValuesFlagsAndPositionals) {
   EXPECT_FALSE(a.flag("--buffer"));
 }
 
-TEST(Cli, RefusesUnknownOptionAndMissingValue) {
-  EXPECT_THROW(cli_parse("check", {"m.mesh", "--bogus"}, {"--report"}, {}), InputError);
-  EXPECT_THROW(cli_parse("check", {"m.mesh", "--report"}, {"--report"}, {}), InputError);
+TEST(Cli, RefusesUnknownOptionAndMissingValueSuggestingTheClosest) {
+  try {
+    cli_parse(cli_refine_command, {"in", "out", "--metod", "sheet"});
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("did you mean --method?"), std::string::npos) << e.what();
+  }
+  try {
+    cli_parse(cli_check_command, {"m.mesh", "--bogus"});
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find("did you mean"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(cli_parse(cli_check_command, {"m.mesh", "--report"}), InputError);
+  EXPECT_EQ(cli_closest("--threds", {"--threads", "--report"}), "--threads");
+  EXPECT_EQ(cli_closest("--x", {"--threads", "--report"}), "");
 }
 
 TEST(Cli, ParsesNumberLists) {
@@ -30,6 +44,36 @@ TEST(Cli, ParsesNumberLists) {
   EXPECT_THROW(cli_parse_doubles("1,nan,2", 3, "--size"), InputError);
   EXPECT_THROW(cli_parse_doubles("1,x,2", 3, "--size"), InputError);
   EXPECT_DOUBLE_EQ(cli_parse_doubles("0.5,1e-3", -1, "x")[1], 1e-3);
+  EXPECT_EQ(cli_parse_int_in("7", 1, 10, "--passes"), 7);
+  EXPECT_THROW(cli_parse_int_in("11", 1, 10, "--passes"), InputError);
+}
+
+TEST(Cli, EveryCommandExplainsItselfAndTheUsageListsEveryOption) {
+  const CliRun top = cli_run("--help");
+  EXPECT_EQ(top.exit_code, 0);
+  std::set<std::string> names;
+  for (const CliCommand* c : cli_commands()) {
+    EXPECT_TRUE(names.insert(c->name).second) << c->name;
+    const CliRun help = cli_run(c->name + " --help");
+    EXPECT_EQ(help.exit_code, 0) << c->name;
+    EXPECT_NE(help.output.find("usage: hexrefine " + c->name), std::string::npos) << help.output;
+    for (const CliOption& o : c->options) {
+      EXPECT_FALSE(o.help.empty()) << c->name << " " << o.name;
+      EXPECT_NE(help.output.find(o.name), std::string::npos) << c->name << " " << o.name;
+      EXPECT_NE(top.output.find(o.name), std::string::npos) << c->name << " " << o.name;
+    }
+  }
+  EXPECT_EQ(names.size(), 11u);
+  // The options the README documents are in the usage.
+  for (const char* o : {"--threads", "--max-hexes", "--binary", "--placement", "--verbose"})
+    EXPECT_NE(top.output.find(o), std::string::npos) << o;
+  // generate's options come from the generator table.
+  const CliRun generate = cli_run("generate --help");
+  for (const char* o : {"--dims", "--jitter", "--tip-fraction", "--section-intervals", "--cell"})
+    EXPECT_NE(generate.output.find(o), std::string::npos) << o;
+  const CliRun unknown = cli_run("refin in out");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.output.find("did you mean refine?"), std::string::npos) << unknown.output;
 }
 
 }  // namespace

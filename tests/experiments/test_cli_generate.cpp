@@ -32,18 +32,20 @@ TEST(CliGenerate, BadUsageExitsTwoAndWritesNothing) {
       {"brick OUT --dims 2,0,2", "dims NY"},
       {"brick OUT --dims 2,2", "--dims"},
       {"brick OUT --dims 2,x,2", "--dims"},
-      {"brick OUT", "--dims"},
       {"brick OUT --dims 2,2,2 --jitter 0.5", "jitter"},
       {"brick OUT --dims 2,2,2 --seed -3", "--seed"},
       {"brick OUT --dims 2,2,2 --size 1,0,1", "size LY"},
       {"brick OUT --dims 2,2,2 --bogus 1", "--bogus"},
       {"brick OUT --dims 2147483647,2147483647,2147483647", "32-bit ids"},
       {"brick --dims 2,2,2", "output path"},
-      {"gear OUT --radii 1,0.5,2", "root_radius"},
-      {"cylinder OUT --intervals 0,3", "square_intervals"},
+      {"gear OUT --inner-radius 1 --root-radius 0.5 --tip-radius 2", "root_radius"},
+      {"gear OUT --radii 1,0.5,2", "--radii"},
+      {"gear OUT --teeth 2.5", "--teeth"},
+      {"cylinder OUT --square-intervals 0 --radial-intervals 3", "square_intervals"},
       {"twisted-ring OUT --around 4", "around"},
       {"stepped OUT --tread 0", "tread"},
       {"sphere OUT", "unknown kind"},
+      {"twisted_ring OUT --around 4", "around"},
   };
   for (const auto& c : cases) {
     const std::string args = generate_args(c.args, out);
@@ -66,8 +68,11 @@ TEST(CliGenerate, WritesReadableMeshes) {
   } cases[] = {
       {"brick OUT --dims 3,4,5 --size 3,2,1 --jitter 0.3 --seed 9", 60},
       {"gear OUT", 8568},
-      {"gear OUT --teeth 5 --intervals 2,2,2,3 --layers 2", 2 * 5 * (5 * 2 + 2 * 2)},
-      {"cylinder OUT --intervals 2,1 --layers 3", 3 * (4 + 4 * 2)},
+      {"gear OUT --teeth 5 --body-radial 2 --tooth-radial 2 --tooth-tangential 2 "
+       "--gap-tangential 3 --layers 2",
+       2 * 5 * (5 * 2 + 2 * 2)},
+      {"cylinder OUT --square-intervals 2 --radial-intervals 1 --layers 3", 3 * (4 + 4 * 2)},
+      {"brick OUT", 1},
       {"twisted-ring OUT --around 8", 8},
       {"stepped OUT", 1188},
   };

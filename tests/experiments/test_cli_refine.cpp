@@ -34,21 +34,30 @@ TEST(CliRefine, LShapedCaseWritesMeshAndReport) {
   mesh_write(in, fixture_brick(10, 10, 10));
   const CliRun r = cli_run(join({"refine", in, out,
                                  "--method selective --select boundary:-1,0,0 --select "
-                                 "boundary:0,0,-1 --report",
+                                 "boundary:0,0,-1 --placement trilinear --report",
                                  (dir / "r.json").string()}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(mesh_read(out).hex_count(), 8060);
   const nlohmann::json j = read_json(dir / "r.json");
   EXPECT_EQ(j.at("method"), "selective");
-  EXPECT_EQ(j.at("initial_hexes"), 1000);
-  EXPECT_EQ(j.at("final_hexes"), 8060);
-  EXPECT_TRUE(j.at("conformal").get<bool>());
-  EXPECT_EQ(j.at("inverted_hexes"), 0);
-  EXPECT_NEAR(j.at("min_scaled_jacobian").get<double>(), 0.3077, 1e-4);
-  EXPECT_GT(j.at("mean_scaled_jacobian").get<double>(), 0.5);
-  EXPECT_EQ(j.at("directional_hexes"), 10);
-  EXPECT_EQ(j.at("hexes_per_template").at("1-13"), 2080);
-  EXPECT_TRUE(j.at("phase_seconds").contains("directional"));
+  EXPECT_EQ(j.at("input"), in);
+  EXPECT_EQ(j.at("options").at("placement").at("method"), "trilinear");
+  EXPECT_EQ(j.at("selection").at("hexes"), 190);
+  const nlohmann::json& refine = j.at("refine");
+  EXPECT_EQ(refine.at("initial_hexes"), 1000);
+  EXPECT_EQ(refine.at("final_hexes"), 8060);
+  EXPECT_EQ(refine.at("directional_hexes"), 10);
+  EXPECT_EQ(refine.at("hexes_per_template").at("1-13"), 2080);
+  EXPECT_TRUE(refine.at("phase_seconds").contains("directional"));
+  const nlohmann::json& check = j.at("check");
+  EXPECT_TRUE(check.at("conformal").get<bool>());
+  EXPECT_EQ(check.at("inverted_hexes"), 0);
+  EXPECT_NEAR(check.at("min_scaled_jacobian").get<double>(), 0.3077, 1e-4);
+  EXPECT_GT(check.at("mean_scaled_jacobian").get<double>(), 0.5);
+  for (const char* stage : {"read", "select", "refine", "check", "write", "total"})
+    EXPECT_TRUE(j.at("stage_seconds").contains(stage)) << stage;
+  EXPECT_GT(j.at("peak_memory_mb").get<double>(), 0);
+  EXPECT_FALSE(j.contains("smoothing"));
 }
 
 TEST(CliRefine, AblationWritesANonConformalMeshAndCountsTheDefects) {
@@ -61,7 +70,7 @@ TEST(CliRefine, AblationWritesANonConformalMeshAndCountsTheDefects) {
                                  (dir / "r.json").string()}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = read_json(dir / "r.json");
-  EXPECT_FALSE(j.at("conformal").get<bool>());
+  EXPECT_FALSE(j.at("check").at("conformal").get<bool>());
   EXPECT_GT(j.at("check").at("non_conformal_faces").get<int>(), 0);
   EXPECT_TRUE(j.at("options").at("ebe_only").get<bool>());
   EXPECT_TRUE(std::filesystem::exists(out));
@@ -73,16 +82,19 @@ TEST(CliRefine, SmoothReportsQualityBeforeAndAfter) {
   mesh_write(in, fixture_brick(4, 4, 4));
   const CliRun r = cli_run(join({"refine", in, out,
                                  "--method selective --select boundary:-1,0,0 --select "
-                                 "boundary:0,0,-1 --smooth --report",
+                                 "boundary:0,0,-1 --placement trilinear --smooth --report",
                                  (dir / "r.json").string()}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = read_json(dir / "r.json");
   // 4^3 L-shape: 28 targets x 27 + 16 face transitions x 13 + 4 corners x 21 + 16 untouched.
-  EXPECT_EQ(j.at("final_hexes"), 28 * 27 + 16 * 13 + 4 * 21 + 16);
-  EXPECT_TRUE(j.at("conformal").get<bool>());
-  EXPECT_TRUE(j.at("check_before_smoothing").at("valid").get<bool>());
-  EXPECT_NEAR(j.at("smooth").at("min_scaled_jacobian_before").get<double>(), 0.3077, 1e-4);
-  EXPECT_GE(j.at("min_scaled_jacobian").get<double>(), 0.3077 - 1e-4);
+  EXPECT_EQ(j.at("refine").at("final_hexes"), 28 * 27 + 16 * 13 + 4 * 21 + 16);
+  EXPECT_TRUE(j.at("check").at("valid").get<bool>());
+  EXPECT_NEAR(j.at("check").at("min_scaled_jacobian").get<double>(), 0.3077, 1e-4);
+  const nlohmann::json& smoothing = j.at("smoothing");
+  EXPECT_TRUE(smoothing.at("check").at("valid").get<bool>());
+  EXPECT_NEAR(smoothing.at("stats").at("min_scaled_jacobian_before").get<double>(), 0.3077, 1e-4);
+  EXPECT_GE(smoothing.at("check").at("min_scaled_jacobian").get<double>(), 0.3077 - 1e-4);
+  EXPECT_TRUE(j.at("stage_seconds").contains("smooth"));
 }
 
 TEST(CliRefine, EmptySelectionWritesTheMeshUnchanged) {
@@ -113,7 +125,10 @@ TEST(CliRefine, BadUsageAndInvertedInputExitTwo) {
   const std::string inverted = shared_mesh("sphere_projected_inverted.mesh");
   const CliRun r = cli_run(join({"refine", inverted, out, "--method selective --select all"}));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("inverted hexes, first at id"), std::string::npos) << r.output;
+  // The input hexes and their scaled Jacobians are named.
+  EXPECT_NE(r.output.find("76 input hexes have a scaled Jacobian <= 0"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("33 (-0.944"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
@@ -128,8 +143,11 @@ TEST(CliRefine, InvalidInputIsReportedAsBadInput) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
-TEST(CliRefine, UnhandledConfigurationExitsOneNamingHexesAndWritesNothing) {
-  // One of the random configurations (results/selective_random.md) the refiner refuses.
+TEST(CliRefine, DistortedParentsAreUntangledNotRefused) {
+  // One of the random configurations (results/selective_random.md) whose trilinear children
+  // invert inside strongly jittered hexes: the default placement untangles them; with the
+  // thesis' trilinear placement the result is invalid, so the command names the input hexes and
+  // writes nothing.
   const auto dir = test_temp_dir("cli_refine_refused");
   const std::string in = (dir / "b.vtk").string(), out = (dir / "o.vtk").string();
   BrickParams bp;
@@ -139,11 +157,17 @@ TEST(CliRefine, UnhandledConfigurationExitsOneNamingHexesAndWritesNothing) {
   bp.seed = 7;
   mesh_write(in, generate_brick(bp));
   std::ofstream(dir / "t.txt") << "0 2 5 8 13 15 25 37 39 47 54";
-  const CliRun r = cli_run(join(
-      {"refine", in, out, "--method selective --select", "hexes:" + (dir / "t.txt").string()}));
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.output.find("input hexes affected"), std::string::npos) << r.output;
+  const std::string select = "--method selective --select hexes:" + (dir / "t.txt").string();
+  const CliRun trilinear = cli_run(join({"refine", in, out, select, "--placement trilinear"}));
+  EXPECT_EQ(trilinear.exit_code, 1) << trilinear.output;
+  EXPECT_NE(trilinear.output.find("inverted hexes"), std::string::npos) << trilinear.output;
+  EXPECT_NE(trilinear.output.find("refined from input hexes"), std::string::npos)
+      << trilinear.output;
   EXPECT_FALSE(std::filesystem::exists(out));
+  const CliRun optimized = cli_run(join({"refine", in, out, select}));
+  EXPECT_EQ(optimized.exit_code, 0) << optimized.output;
+  EXPECT_NE(optimized.output.find(", conformal, 0 inverted"), std::string::npos)
+      << optimized.output;
 }
 
 }  // namespace

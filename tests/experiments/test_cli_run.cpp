@@ -122,22 +122,26 @@ TEST(CliRun, RunsBothMethodsOnTheSameTargetsAndChecksTheOutputs) {
     const json& full = c.records[i];
     EXPECT_EQ(full["method"], i == 0 ? "selective" : "sheet");
     EXPECT_FALSE(full.contains("error")) << full.dump();
-    EXPECT_EQ(full["initial_hexes"], 27);
+    EXPECT_EQ(full["input"]["hexes"], 27);
     EXPECT_EQ(full["selection"]["hexes"], 27);
-    EXPECT_EQ(full["final_hexes"], 729);
-    EXPECT_EQ(full["final_nodes"], 1000);
-    EXPECT_EQ(full["conformal"], true);
-    EXPECT_EQ(full["inverted_hexes"], 0);
-    EXPECT_DOUBLE_EQ(full["min_scaled_jacobian"].get<double>(), 1.0);
-    EXPECT_EQ(full["scaled_jacobian_histogram"]["counts"][19], 729);
+    EXPECT_EQ(full["selection"]["specs"], json({"all"}));
+    EXPECT_EQ(full["refine"]["initial_hexes"], 27);
+    EXPECT_EQ(full["refine"]["final_hexes"], 729);
+    EXPECT_EQ(full["refine"]["final_nodes"], 1000);
+    EXPECT_EQ(full["check"]["conformal"], true);
+    EXPECT_EQ(full["check"]["inverted_hexes"], 0);
+    EXPECT_DOUBLE_EQ(full["check"]["min_scaled_jacobian"].get<double>(), 1.0);
+    EXPECT_EQ(full["check"]["scaled_jacobian_histogram"]["counts"][19], 729);
+    EXPECT_TRUE(full["stage_seconds"].contains("refine"));
     EXPECT_EQ(full["input"]["generate"], "brick");
     EXPECT_EQ(full["input"]["dims"], json({3, 3, 3}));
+    EXPECT_EQ(full["input"]["jitter"], 0.0);  // the generator's defaults are recorded too
     EXPECT_TRUE(fs::exists(dir / "r.meshes" / run_mesh_file_name("full", full["method"])));
   }
   const json& inp = c.records[2];
-  EXPECT_EQ(inp["final_hexes"], 216);
+  EXPECT_EQ(inp["refine"]["final_hexes"], 216);
   EXPECT_EQ(inp["input"]["sha256"], sha256_hex(test_file_text(abaqus)));
-  EXPECT_EQ(inp["conformal"], true);
+  EXPECT_EQ(inp["check"]["conformal"], true);
   const json& bad = c.records[3];
   EXPECT_EQ(bad["error_kind"], "input");
   EXPECT_NE(bad["error"].get<std::string>().find("boxx"), std::string::npos);
@@ -160,18 +164,14 @@ TEST(PlotsPy, PutsOursBesideTheThesisWithRatios) {
   auto g1 = [](const std::string& method, int final_hexes, double seconds, double min_sj) {
     json r = record("G-1", 0, method, method == "selective" ? 0 : 1);
     r["tags"] = {{"table", "G-1"}};
-    r["initial_hexes"] = 1000;
-    r["final_hexes"] = final_hexes;
-    r["time_seconds"] = seconds;
-    r["min_scaled_jacobian"] = min_sj;
-    r["input"] = {{"generate", "brick"}, {"initial_min_scaled_jacobian", 1.0}};
-    r["conformal"] = true;
-    r["inverted_hexes"] = 0;
+    r["refine"] = {{"final_hexes", final_hexes}, {"time_seconds", seconds}};
+    r["check"] = {{"min_scaled_jacobian", min_sj}, {"conformal", true}, {"inverted_hexes", 0}};
+    r["input"] = {{"generate", "brick"}, {"hexes", 1000}, {"initial_min_scaled_jacobian", 1.0}};
     return r;
   };
   json sweep = record("G-2/n=10", 1, "sheet", 1);
   sweep["tags"] = {{"table", "G-2"}, {"n", 10}};
-  sweep["initial_hexes"] = 1000;
+  sweep["input"] = {{"generate", "brick"}, {"hexes", 1000}};
   sweep["error"] = "sheet refinement refused";
   test_file_put(dir / "r.jsonl", g1("selective", 8060, 0.0797, 0.3077).dump() + "\n" +
                                      g1("sheet", 27000, 3.242, 1.0).dump() + "\n" + sweep.dump() +

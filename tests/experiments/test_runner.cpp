@@ -147,12 +147,16 @@ TEST(RunPlan, SchemaErrorsNameFileAndJsonPath) {
   c = brick_case("a");
   c["methods"] = {"selective", "octree"};
   EXPECT_EQ(error_of(json{{"cases", {c}}}),
-            "cases.json: /cases/0/methods/1: unknown method 'octree' (expected selective or "
-            "sheet)");
+            "cases.json: /cases/0/methods/1: unknown refinement method 'octree' (expected one "
+            "of: selective, sheet)");
   c = brick_case("a");
-  c["mesh"]["dims"] = {2, 0, 2};
+  c["mesh"]["dims"] = {2, 0.5, 2};
   EXPECT_EQ(error_of(json{{"cases", {c}}}),
-            "cases.json: /cases/0/mesh/dims/1: expected an integer >= 1");
+            "cases.json: /cases/0/mesh/dims: expected 3 integers, got [2,0.5,2]");
+  c = brick_case("a");
+  c["options"] = {{"placement", "smooth"}};
+  EXPECT_EQ(error_of(json{{"cases", {c}}}),
+            "cases.json: /cases/0/options/placement: expected \"trilinear\" or \"optimized\"");
   c = brick_case("a");
   c["mesh"]["radius"] = 1.0;
   EXPECT_NE(error_of(json{{"cases", {c}}})
@@ -202,7 +206,13 @@ TEST(RunRecordKey, OptionsAreCanonical) {
             run_record_key("G-1", "selective", run_options_to_json(other, false)));
   EXPECT_NE(run_record_key("G-1", "selective", run_options_to_json(defaults, false)),
             run_record_key("G-1", "selective", run_options_to_json(defaults, true)));
-  EXPECT_EQ(run_options_to_json(defaults, false).size(), 7u);
+  // Every RefineOptions field but threads (the output does not depend on it), and "smooth".
+  EXPECT_EQ(run_options_to_json(defaults, false).size(), 8u);
+  EXPECT_FALSE(run_options_to_json(defaults, false).contains("threads"));
+  RefineOptions trilinear;
+  trilinear.placement.method = PlacementMethod::trilinear;
+  EXPECT_NE(run_record_key("G-1", "selective", run_options_to_json(defaults, false)),
+            run_record_key("G-1", "selective", run_options_to_json(trilinear, false)));
 }
 
 TEST(Jsonl, AppendsAndReadsBack) {
@@ -411,20 +421,6 @@ TEST(RunEnvironment, DetectsCommitMachineAndBuild) {
 TEST(RunMeshFileName, ReplacesPathCharacters) {
   EXPECT_EQ(run_mesh_file_name("G-3/n=20", "selective"), "G-3_n=20.selective.vtu");
   EXPECT_EQ(run_mesh_file_name("a b:c", "sheet"), "a_b_c.sheet.vtu");
-}
-
-TEST(ScaledJacobianHistogram, FixedBins) {
-  const std::vector<int64_t> h =
-      scaled_jacobian_histogram({1.0, 0.95, 0.3077, 0.0, -0.05, -1.0, -3.0, 2.0});
-  ASSERT_EQ(h.size(), 20u);
-  EXPECT_EQ(h[19], 3);  // 1.0, 0.95 and 2.0 (clamped)
-  EXPECT_EQ(h[13], 1);  // 0.3077 in [0.3, 0.4)
-  EXPECT_EQ(h[10], 1);  // 0.0 in [0, 0.1)
-  EXPECT_EQ(h[9], 1);   // -0.05 in [-0.1, 0)
-  EXPECT_EQ(h[0], 2);   // -1.0 and -3.0 (clamped)
-  int64_t total = 0;
-  for (int64_t v : h) total += v;
-  EXPECT_EQ(total, 8);
 }
 
 TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {

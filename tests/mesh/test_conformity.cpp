@@ -303,8 +303,16 @@ TEST(Conformity, EmptyMesh) {
 
 TEST(Conformity, JsonCarriesEveryCount) {
   const MeshCheckReport r = mesh_check(brick_with_one_octree_split(), nullptr);
-  const nlohmann::json j = mesh_check_to_json(r);
+  const nlohmann::json j = r;
   EXPECT_EQ(j["hexes"], 9);
+  // The hexes of the five non-conformal faces (the split hex's children and its neighbour),
+  // the lowest first; the histogram holds every hex.
+  EXPECT_FALSE(r.defect_hexes.empty());
+  EXPECT_TRUE(std::is_sorted(r.defect_hexes.begin(), r.defect_hexes.end()));
+  int64_t histogram_total = 0;
+  for (int64_t c : r.scaled_jacobian_histogram) histogram_total += c;
+  EXPECT_EQ(histogram_total, 9);
+  EXPECT_EQ(r.scaled_jacobian_histogram[19], 9);  // all cubes
   EXPECT_EQ(j["non_conformal_faces"], 5);
   EXPECT_EQ(j["hanging_nodes"], 5);
   EXPECT_EQ(j["conformal"], false);
@@ -314,6 +322,20 @@ TEST(Conformity, JsonCarriesEveryCount) {
                           "boundary_faces", "min_scaled_jacobian", "mean_scaled_jacobian", "volume",
                           "boundary_area", "first_inverted_hex", "reference_compared"})
     EXPECT_TRUE(j.contains(key)) << key;
+}
+
+TEST(ScaledJacobianHistogram, FixedBins) {
+  const std::vector<int64_t> h =
+      scaled_jacobian_histogram({1.0, 0.95, 0.3077, 0.0, -0.05, -1.0, -3.0, 2.0});
+  ASSERT_EQ(h.size(), 20u);
+  EXPECT_EQ(h[19], 3);  // 1.0, 0.95 and 2.0 (clamped)
+  EXPECT_EQ(h[13], 1);  // 0.3077 in [0.3, 0.4)
+  EXPECT_EQ(h[10], 1);  // 0.0 in [0, 0.1)
+  EXPECT_EQ(h[9], 1);   // -0.05 in [-0.1, 0)
+  EXPECT_EQ(h[0], 2);   // -1.0 and -3.0 (clamped)
+  int64_t total = 0;
+  for (int64_t v : h) total += v;
+  EXPECT_EQ(total, 8);
 }
 
 }  // namespace

@@ -1,18 +1,14 @@
-#include "algorithms/templates.hpp"
+#include "algorithms/template_library.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <set>
 
 #include "mesh/error.hpp"
-#include "mesh/generators.hpp"
 #include "mesh/hex_convention.hpp"
-#include "mesh/topology.hpp"
-#include "tests/fixtures.hpp"
 
 namespace hexrefine {
 namespace {
@@ -104,23 +100,6 @@ int template_faces_check(const HexTemplate& t, std::set<int> collapsed = {}) {
   return checked;
 }
 
-TEST(CubeSymmetries, FortyEightDistinctWithTwentyFourReflections) {
-  const auto& s = cube_symmetries();
-  std::set<std::array<int8_t, 8>> maps;
-  int reflections = 0;
-  for (const CubeSymmetry& x : s) {
-    maps.insert(x.vertex);
-    reflections += x.reflection;
-    // Edge and face maps are bijections consistent with the vertex map.
-    std::set<int> edges(x.edge.begin(), x.edge.end()), faces(x.face.begin(), x.face.end());
-    EXPECT_EQ(edges.size(), 12u);
-    EXPECT_EQ(faces.size(), 6u);
-  }
-  EXPECT_EQ(maps.size(), 48u);
-  EXPECT_EQ(reflections, 24);
-  for (int v = 0; v < 8; ++v) EXPECT_EQ(s[0].vertex[v], v);  // identity first
-}
-
 TEST(Templates, SplitEdgeMasks) {
   EXPECT_EQ(template_split_edges(template_1_27()), 0xFFF);
   EXPECT_EQ(template_split_edges(template_1_3()), (1 << 0) | (1 << 2) | (1 << 4) | (1 << 6));
@@ -200,6 +179,69 @@ TEST(Templates, MaskTableCoversTheSevenPatternsUnderAllSymmetries) {
   EXPECT_EQ(template_for_mask(0).tmpl, nullptr);
 }
 
+TEST(Templates, SheetDirectionalSetHasOneToNineAndNoAdjustments) {
+  std::map<TemplateTag, int> per_tag;
+  for (int m = 1; m < 4096; ++m) {
+    const TemplateChoice c =
+        template_for_mask(static_cast<uint16_t>(m), TemplateSet::sheet_directional);
+    if (!c.tmpl) continue;
+    ++per_tag[c.tmpl->tag];
+    EXPECT_EQ(cube_symmetry_edge_mask(cube_symmetries()[c.symmetry], template_split_edges(*c.tmpl)),
+              m);
+  }
+  EXPECT_EQ(per_tag[TemplateTag::t1_3], 3);
+  EXPECT_EQ(per_tag[TemplateTag::t1_4], 12);
+  EXPECT_EQ(per_tag[TemplateTag::t1_5], 12);
+  EXPECT_EQ(per_tag[TemplateTag::t1_9], 3);  // one per pair of axes
+  EXPECT_EQ(per_tag[TemplateTag::t1_27], 1);
+  EXPECT_EQ(per_tag.count(TemplateTag::t1_13), 0u);
+  EXPECT_EQ(per_tag.count(TemplateTag::t1_3_adjust1), 0u);
+  EXPECT_EQ(template_1_9().children.size(), 9u);
+  EXPECT_DOUBLE_EQ(template_validate(template_1_9()), 1.0);
+}
+
+TEST(Templates, TagNamesAreDistinct) {
+  std::set<std::string> names;
+  for (int t = 0; t < template_tag_count; ++t)
+    names.insert(template_tag_name(static_cast<TemplateTag>(t)));
+  EXPECT_EQ(names.size(), static_cast<size_t>(template_tag_count));
+  EXPECT_STREQ(template_tag_name(TemplateTag::t1_3_adjust2), "1-3-adj2");
+  EXPECT_STREQ(template_tag_name(static_cast<TemplateTag>(99)), "unknown");
+}
+
+TEST(Templates, CompiledPlansClassifyEveryNode) {
+  // 1-27 in the identity: 8 corners, 24 edge nodes, 24 face nodes, 8 interior nodes; all on the
+  // slot grid. 1-13: its interior nodes at 1/6 are off the slot grid only inside the cube.
+  std::map<CubeEntity, int> count;
+  for (const TemplatePlanNode& n : template_1_27().plans[0].nodes) ++count[n.entity];
+  EXPECT_EQ(count[CubeEntity::corner], 8);
+  EXPECT_EQ(count[CubeEntity::edge], 24);
+  EXPECT_EQ(count[CubeEntity::face], 24);
+  EXPECT_EQ(count[CubeEntity::interior], 8);
+  for (const HexTemplate* t :
+       {&template_1_27(), &template_1_13(), &template_1_5(), &template_1_4(), &template_1_3(),
+        &template_1_9(), &template_1_3_adjust1(), &template_1_3_adjust2()}) {
+    ASSERT_EQ(t->plans.size(), 48u);
+    for (const TemplatePlan& p : t->plans) {
+      EXPECT_TRUE(p.slotted) << template_tag_name(t->tag);
+      for (const TemplatePlanNode& n : p.nodes) {
+        EXPECT_FALSE(n.off_grid);
+        double sum = 0;
+        for (double w : n.weight) sum += w;
+        EXPECT_NEAR(sum, 1.0, 1e-15);
+      }
+    }
+  }
+  // A node off the exact grid inside the cube is compiled as a private interior node; on the
+  // cube's boundary it is refused.
+  HexTemplate t = template_1_3();
+  t.nodes.push_back({{0.3, 1.0 / 7.0, 0.5}});
+  template_compile(t, 1);
+  EXPECT_TRUE(t.plans[0].nodes.back().off_grid);
+  t.nodes.back().ref = {0.0, 1.0 / 7.0, 0.5};
+  EXPECT_THROW(template_compile(t, 1), OperationError);
+}
+
 TEST(Templates, ChildDirectionsFollowSheets) {
   // 1-3: every slab keeps the cube's axes.
   for (const auto& a : template_1_3().child_axis) EXPECT_EQ(a, (std::array<int8_t, 3>{0, 1, 2}));
@@ -226,55 +268,6 @@ TEST(Templates, ValidateRejectsAnInvertedChild) {
   HexTemplate t = template_1_3();
   std::swap(t.children[1][0], t.children[1][1]);
   EXPECT_THROW(template_validate(t), OperationError);
-}
-
-TEST(TemplatesApply, FullRefinementOfTwoCubedBrickSharesNodes) {
-  const HexMesh m = fixture_brick(2, 2, 2);
-  const HexTopology t = topology_build(m);
-  std::vector<TemplateApplication> apps;
-  for (int32_t h = 0; h < m.hex_count(); ++h) apps.push_back({h, &template_1_27(), 0});
-  const TemplateApplyResult r = templates_apply(m, t, apps);
-  EXPECT_EQ(r.mesh.hex_count(), 216);
-  EXPECT_EQ(r.mesh.point_count(), 7 * 7 * 7);
-  EXPECT_EQ(r.hexes_created, 216);
-  EXPECT_EQ(r.hexes_deleted, 8);
-  const HexTopology rt = topology_build(r.mesh);
-  EXPECT_EQ(topology_boundary_faces(rt).size(), 6u * 36u);
-  const auto* tag = mesh_find_attribute(r.mesh, attribute_template_tag);
-  ASSERT_NE(tag, nullptr);
-  EXPECT_EQ((*tag)[0], static_cast<int32_t>(TemplateTag::t1_27));
-}
-
-TEST(TemplatesApply, OneToThreeInEverySymmetryStaysConformal) {
-  // Two hexes side by side in x, both split across y: the shared face must be split identically
-  // from both sides whatever orientation each template is applied in.
-  const HexMesh m = fixture_brick(2, 1, 1);
-  const HexTopology t = topology_build(m);
-  const uint16_t canonical = template_split_edges(template_1_3());
-  const uint16_t wanted = (1 << 1) | (1 << 3) | (1 << 5) | (1 << 7);  // the y-parallel edges
-  int tried = 0;
-  for (int s0 = 0; s0 < 48; ++s0) {
-    if (cube_symmetry_edge_mask(cube_symmetries()[s0], canonical) != wanted) continue;
-    for (int s1 = 0; s1 < 48; ++s1) {
-      if (cube_symmetry_edge_mask(cube_symmetries()[s1], canonical) != wanted) continue;
-      const std::vector<TemplateApplication> apps = {{0, &template_1_3(), int8_t(s0)},
-                                                     {1, &template_1_3(), int8_t(s1)}};
-      const TemplateApplyResult r = templates_apply(m, t, apps);
-      ASSERT_EQ(r.mesh.hex_count(), 6);
-      ASSERT_EQ(r.mesh.point_count(), 24);
-      const HexTopology rt = topology_build(r.mesh);
-      ASSERT_EQ(topology_boundary_faces(rt).size(), 22u);  // as a 2x3x1 brick
-      // Positive orientation: the corner Jacobian at vertex 0 of every child.
-      for (const HexCell& c : r.mesh.hexes) {
-        const Eigen::Vector3d o = r.mesh.points[c[0]];
-        const double det =
-            (r.mesh.points[c[1]] - o).cross(r.mesh.points[c[3]] - o).dot(r.mesh.points[c[4]] - o);
-        ASSERT_GT(det, 0);
-      }
-      ++tried;
-    }
-  }
-  EXPECT_EQ(tried, 16 * 16);  // 16 symmetries map the x-slabs onto the y-slabs
 }
 
 TEST(Templates, BasicTemplatesSubdivideAFaceAsAFunctionOfItsSplitEdges) {
@@ -349,53 +342,6 @@ TEST(Templates, BasicTemplatesSubdivideAFaceAsAFunctionOfItsSplitEdges) {
   EXPECT_EQ(faces, 5 * 48 * 6);
   // Split sides met: none, one (4 ways), two opposite (2), all four.
   EXPECT_EQ(pattern_of_mask.size(), 8u);
-}
-
-TEST(TemplateRefiner, CompiledApplicationMatchesTheGenericOne) {
-  // apply_whole walks the compiled plan; apply() derives every key from exact positions. On a
-  // jittered mesh with shuffled node ids both must create the same nodes, in the same order, at
-  // bit-identical positions, under the same keys.
-  BrickParams bp;
-  bp.dims = {3, 3, 3};
-  bp.jitter = 0.2;
-  HexMesh m = generate_brick(bp);
-  std::vector<int32_t> perm(m.point_count());
-  for (int32_t i = 0; i < m.point_count(); ++i) perm[i] = (i * 37) % m.point_count();
-  for (HexCell& c : m.hexes)
-    for (int32_t& v : c) v = perm[v];
-  std::vector<Eigen::Vector3d> pts(m.points.size());
-  for (int32_t i = 0; i < m.point_count(); ++i) pts[perm[i]] = m.points[i];
-  m.points = pts;
-  const HexTopology topo = topology_build(m);
-  const HexTemplate* all[] = {&template_1_27(), &template_1_13(), &template_1_5(), &template_1_4(),
-                              &template_1_3()};
-  int compared = 0;
-  for (const HexTemplate* t : all) {
-    for (int sym = 0; sym < 48; sym += 5) {
-      TemplateRefiner generic(m, topo), compiled(m, topo), direct(m, topo);
-      direct.set_record_keys(false);  // the path straight to the slots, without keys
-      std::vector<HexCell> a, b, c;
-      for (int32_t h = 0; h < m.hex_count(); h += 2) {
-        std::vector<TemplateCell> cells;
-        generic.apply(generic.cell_whole(h), *t, sym, cells);
-        for (const TemplateCell& cell : cells) a.push_back(cell.nodes);
-        compiled.apply_whole(h, *t, sym, false, b);
-        direct.apply_whole(h, *t, sym, false, c);
-      }
-      ASSERT_EQ(a, b) << template_tag_name(t->tag) << " symmetry " << sym;
-      ASSERT_EQ(a, c) << template_tag_name(t->tag) << " symmetry " << sym;
-      ASSERT_EQ(generic.points().size(), compiled.points().size());
-      ASSERT_EQ(generic.points().size(), direct.points().size());
-      for (size_t i = 0; i < generic.points().size(); ++i) {
-        ASSERT_EQ(generic.points()[i], compiled.points()[i]);
-        ASSERT_EQ(generic.points()[i], direct.points()[i]);
-      }
-      EXPECT_TRUE(direct.created_keys().empty());
-      ASSERT_EQ(generic.created_keys(), compiled.created_keys());
-      ++compared;
-    }
-  }
-  EXPECT_EQ(compared, 5 * 10);
 }
 
 }  // namespace

@@ -1,0 +1,51 @@
+#pragma once
+/// \file
+/// Node placement: where the nodes a refinement pass created go. See node_placement.cpp for the
+/// objective, the optimizer and its sources.
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string_view>
+
+namespace hexrefine {
+
+enum class PlacementMethod : uint8_t {
+  /// Every new node stays at the parent's trilinear map of the template's reference position
+  /// (the thesis' placement: its tables are reproduced with it).
+  trilinear,
+  /// Trilinear first, then the new nodes around poor children move to raise the worst scaled
+  /// Jacobian around them, inverted children untangled first (node_placement.cpp).
+  optimized,
+};
+NLOHMANN_JSON_SERIALIZE_ENUM(PlacementMethod, {{PlacementMethod::trilinear, "trilinear"},
+                                               {PlacementMethod::optimized, "optimized"}})
+
+/// "trilinear" / "optimized".
+std::string_view placement_method_name(PlacementMethod m);
+
+struct PlacementOptions {
+  PlacementMethod method = PlacementMethod::optimized;
+  /// A child is worked on when its scaled Jacobian is below active_ratio times its parent's
+  /// (in (0, 1]): children of a parallelepiped by a box template (1-27, 1-9, 1-3) equal their
+  /// parent and are left alone, transition children (1-13: 4/13 of the parent) are not.
+  double active_ratio = 0.9;
+  int max_sweeps = 12;  ///< >= 0: Gauss-Seidel sweeps over the active nodes, worst first
+};
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementOptions, method, active_ratio, max_sweeps)
+
+struct PlacementStats {
+  int64_t active_hexes = 0;  ///< children worked on (all passes)
+  int64_t free_nodes = 0;    ///< new nodes that could move (interior, or sliding on the boundary)
+  int64_t nodes_moved = 0;   ///< of those, the ones that moved
+  int64_t inverted_before = 0;  ///< children inverted at their trilinear positions
+  int64_t untangled = 0;        ///< of those, the ones placement made valid
+  int sweeps = 0;               ///< sweeps carried out (largest over the passes)
+  /// Minimum scaled Jacobian over the active children before and after (1 if none).
+  double min_before = 1, min_after = 1;
+  double seconds = 0;
+};
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementStats, active_hexes, free_nodes,
+                                                nodes_moved, inverted_before, untangled, sweeps,
+                                                min_before, min_after, seconds)
+
+}  // namespace hexrefine

@@ -1,0 +1,207 @@
+#include "algorithms/pipeline.hpp"
+
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <numeric>
+#include <ostream>
+#include <sstream>
+
+#include "mesh/error.hpp"
+#include "mesh/selection.hpp"
+
+namespace hexrefine {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// Ends a stage: its time goes to the result and, with --verbose, to the stream.
+class StageClock {
+ public:
+  StageClock(PipelineResult& result, std::ostream* verbose) : result_(result), verbose_(verbose) {}
+  void end(const std::string& stage) {
+    const double s = seconds_since(start_);
+    result_.stage_seconds[stage] += s;
+    if (verbose_)
+      *verbose_ << "hexrefine: " << stage << " " << std::fixed << std::setprecision(3) << s << " s"
+                << std::endl;
+    start_ = Clock::now();
+  }
+
+ private:
+  PipelineResult& result_;
+  std::ostream* verbose_;
+  Clock::time_point start_ = Clock::now();
+};
+
+/// n * 27^passes, saturated at INT64_MAX.
+int64_t refine_hex_bound(int64_t hexes, int passes) {
+  int64_t bound = hexes;
+  for (int p = 0; p < passes; ++p)
+    bound = bound > std::numeric_limits<int64_t>::max() / 27 ? std::numeric_limits<int64_t>::max()
+                                                             : bound * 27;
+  return bound;
+}
+
+void size_bound_check(const HexMesh& input, const PipelineOptions& o) {
+  const int passes = o.refine.passes;
+  const int64_t bound = refine_hex_bound(input.hex_count(), passes);
+  if (bound <= o.max_hexes) return;
+  std::ostringstream estimate;
+  if (bound < std::numeric_limits<int64_t>::max())
+    estimate << bound;
+  else
+    estimate << std::setprecision(3)
+             << static_cast<double>(input.hex_count()) * std::pow(27.0, passes);
+  throw OperationError("the input has " + std::to_string(input.hex_count()) + " hexes; " +
+                       std::to_string(passes) + " passes can give up to " +
+                       std::to_string(input.hex_count()) + " x 27^" + std::to_string(passes) +
+                       " = " + estimate.str() + " hexes, above the limit of " +
+                       std::to_string(o.max_hexes) +
+                       " hexes (--max-hexes; at most 2^31 - 1, the int32 hex ids); nothing "
+                       "refined or written: use fewer passes");
+}
+
+/// Throws when `check` (of `mesh`, refined from `input`) is invalid and no switch allows it.
+void verdict_enforce(const MeshCheckReport& check, const HexMesh& mesh, const HexMesh& input,
+                     const PipelineOptions& o, bool ablation, const std::string& what) {
+  if (check.valid() || ablation || o.refine.allow_inverted) return;
+  // An input that already fails the checker (e.g. a voxel mesh whose cubes touch along edges)
+  // is bad input, not a refiner failure.
+  const MeshCheckReport input_check = mesh_check(input);
+  if (!input_check.valid()) {
+    std::string why;
+    for (const std::string& d : mesh_check_defects(input_check)) why += "\n  " + d;
+    throw InputError("the input mesh is not valid, so no refinement of it can be:" + why);
+  }
+  std::string why;
+  for (const std::string& d : mesh_check_defects(check)) why += "\n  " + d;
+  if (const std::vector<int32_t>* parent = mesh_find_attribute(mesh, attribute_parent_hex)) {
+    std::vector<int32_t> parents;
+    for (int32_t h : check.defect_hexes) parents.push_back((*parent)[h]);
+    std::sort(parents.begin(), parents.end());
+    parents.erase(std::unique(parents.begin(), parents.end()), parents.end());
+    why += "\n  refined from input hexes";
+    for (int32_t p : parents) {
+      why += ' ';
+      why += std::to_string(p);
+    }
+  }
+  throw OperationError(what + " left an invalid mesh; nothing written:" + why);
+}
+
+}  // namespace
+
+double process_peak_memory_mb() {
+  rusage usage{};
+  if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KB on Linux
+}
+
+PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
+  const auto start = Clock::now();
+  PipelineResult r;
+  StageClock clock(r, o.verbose);
+  const RefineMethod& method = refine_method(o.method);
+  r.ablation = !o.refine.ranking || !o.refine.propagation || o.refine.ebe_only;
+
+  if (o.targets) {
+    r.selected = *o.targets;
+  } else {
+    Selection selection = select_hexes(input, o.select);
+    r.selected = std::move(selection.hexes);
+    r.selection_warning = std::move(selection.warning);
+  }
+  clock.end("select");
+
+  size_bound_check(input, o);
+  if (r.selected.empty()) {
+    // Nothing to refine: the input, with the attributes a refinement adds.
+    r.mesh = input;
+    std::vector<int32_t> parent(input.hexes.size()), tag_of(input.hexes.size(), -1);
+    std::iota(parent.begin(), parent.end(), 0);
+    mesh_attributes_from_parents(input, parent, tag_of, r.mesh);
+    r.stats.method = o.method;
+    r.stats.initial_hexes = r.stats.final_hexes = input.hex_count();
+    r.stats.final_nodes = input.point_count();
+  } else {
+    RefineResult refined = refine(method, input, Targets{r.selected}, o.refine);
+    r.mesh = std::move(refined.mesh);
+    r.stats = std::move(refined.stats);
+  }
+  clock.end("refine");
+
+  r.check = mesh_check(r.mesh, &input);
+  clock.end("check");
+  verdict_enforce(r.check, r.mesh, input, o, r.ablation, "the " + o.method + " refiner");
+
+  if (o.smooth) {
+    SmoothOptions so = o.smoothing;
+    so.region_hexes = mesh_refined_hexes(r.mesh);
+    if (!so.region_hexes.empty()) {
+      r.smoothing = mesh_smooth(r.mesh, so);
+      clock.end("smooth");
+      // Smoothing slides boundary nodes within planar faces: the smoothed mesh no longer
+      // subdivides the input's faces exactly, so it is checked on its own.
+      r.smoothed_check = mesh_check(r.mesh);
+      clock.end("check_smoothed");
+      verdict_enforce(*r.smoothed_check, r.mesh, input, o, r.ablation, "smoothing");
+    }
+  }
+  r.stage_seconds["total"] = seconds_since(start);
+  r.peak_memory_mb = process_peak_memory_mb();
+  return r;
+}
+
+PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
+                                  const PipelineOptions& options) {
+  const auto start = Clock::now();
+  PipelineResult scratch;
+  StageClock clock(scratch, options.verbose);
+  const HexMesh input = mesh_read(in);
+  clock.end("read");
+  PipelineResult r;
+  try {
+    r = pipeline_run(input, options);
+  } catch (const InputError& e) {
+    throw InputError(in + ": " + e.what());  // the input, or a spec applied to it
+  }
+  if (!out.empty()) {
+    StageClock write_clock(r, options.verbose);
+    mesh_write(out, r.mesh, options.write);
+    write_clock.end("write");
+  }
+  r.stage_seconds["read"] = scratch.stage_seconds["read"];
+  r.stage_seconds["total"] = seconds_since(start);
+  r.peak_memory_mb = process_peak_memory_mb();
+  return r;
+}
+
+nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o) {
+  nlohmann::json j;
+  j["method"] = o.method;
+  j["options"] = o.refine;
+  j["options"]["smooth"] = o.smooth;
+  nlohmann::json selection = {{"hexes", r.selected.size()}};
+  if (o.targets)
+    selection["specs"] = nlohmann::json::array({"targets given by id"});
+  else
+    selection["specs"] = o.select;
+  if (!r.selection_warning.empty()) selection["warning"] = r.selection_warning;
+  j["selection"] = selection;
+  j["refine"] = r.stats;
+  j["check"] = r.check;
+  if (r.smoothing) j["smoothing"] = {{"stats", *r.smoothing}, {"check", *r.smoothed_check}};
+  j["stage_seconds"] = r.stage_seconds;
+  j["peak_memory_mb"] = r.peak_memory_mb;
+  return j;
+}
+
+}  // namespace hexrefine

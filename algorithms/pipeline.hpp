@@ -1,0 +1,87 @@
+#pragma once
+/// \file
+/// The refinement pipeline, one function for every front end (the CLI's `refine`, the experiment
+/// runner, the benchmarks, the Python module):
+///   read -> select -> refine (per pass: plan, apply, place nodes) -> check -> smooth -> check
+///   -> write,
+/// each stage timed (PipelineResult::stage_seconds), the report one JSON object
+/// (pipeline_report) with the same keys wherever it is written.
+///
+/// Verdicts: the result is checked against the input by the project's checker
+/// (mesh/conformity.hpp). Without an ablation switch (ranking, propagation or ebe_only off) or
+/// allow_inverted, an invalid result is an error: InputError if the input itself fails the
+/// checker (bad input, not a refiner failure), OperationError otherwise, naming the defects and
+/// the input hexes they descend from; nothing is returned or written. With an ablation switch the
+/// result may be non-conformal by design and is returned with the checker's counts.
+/// Smoothing (optional) moves the refined region's nodes (algorithms/smoothing.hpp) and is
+/// checked again the same way.
+
+#include <cstdint>
+#include <iosfwd>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "algorithms/refiner.hpp"
+#include "algorithms/smoothing.hpp"
+#include "mesh/conformity.hpp"
+#include "mesh/hex_mesh.hpp"
+#include "mesh/io.hpp"
+
+namespace hexrefine {
+
+struct PipelineOptions {
+  std::string method = "selective";  ///< a name of refine_methods()
+  /// Selection specs (mesh/selection.hpp), united; ignored when `targets` is set.
+  std::vector<std::string> select;
+  std::optional<std::vector<int32_t>> targets;  ///< explicit target hex ids instead of `select`
+  RefineOptions refine;
+  bool smooth = false;
+  SmoothOptions smoothing;  ///< its region_hexes is replaced by the refined hexes
+  /// Refuse before refining when n * 27^passes could exceed this many output hexes (int32 ids).
+  int64_t max_hexes = std::numeric_limits<int32_t>::max();
+  MeshWriteOptions write;  ///< how pipeline_run_files writes the output
+  /// Where stage lines go as stages end ("select: 0.012 s"), or nullptr.
+  std::ostream* verbose = nullptr;
+};
+
+struct PipelineResult {
+  HexMesh mesh;  ///< the refined (and smoothed) mesh
+  RefineStats stats;
+  std::vector<int32_t> selected;  ///< the targets, ascending
+  std::string selection_warning;  ///< non-empty when the selection matched nothing
+  MeshCheckReport check;          ///< the refined mesh against the input
+  std::optional<SmoothStats> smoothing;
+  std::optional<MeshCheckReport> smoothed_check;  ///< the smoothed mesh against the input
+  /// Seconds per stage: read, select, refine, check, smooth, check_smoothed, write, total
+  /// (read and write only from pipeline_run_files).
+  std::map<std::string, double> stage_seconds;
+  double peak_memory_mb = 0;  ///< the process's peak resident size when the pipeline ended
+  /// A refinement switch that may give a non-conformal mesh by design (ablation).
+  bool ablation = false;
+};
+
+/// Runs select -> refine -> check -> smooth -> check on an in-memory mesh. Throws InputError for
+/// bad options, specs or input, OperationError when the method refuses, the size bound is
+/// exceeded or the result is invalid (see the file comment). An empty selection is not an error:
+/// the mesh is returned unchanged (with the attributes a refinement adds) and the warning set.
+PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& options);
+
+/// read `in` -> pipeline_run -> write `out` (atomically; not written when the pipeline throws).
+/// `out` may be empty (nothing written). Adds the read and write stages.
+PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
+                                  const PipelineOptions& options);
+
+/// The report: "method", "options" (RefineOptions plus "smooth"), "selection" ({"specs",
+/// "hexes", "warning"?}), "refine" (RefineStats), "check", "smoothing"? ({"stats", "check"}),
+/// "stage_seconds", "peak_memory_mb". The CLI writes it with --report, the runner adds its
+/// identification fields to it, the Python module returns it as a dict.
+nlohmann::json pipeline_report(const PipelineResult& result, const PipelineOptions& options);
+
+/// Peak resident set size of this process in MB (getrusage), 0 if unknown.
+double process_peak_memory_mb();
+
+}  // namespace hexrefine

@@ -5,7 +5,12 @@
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string_view>
+#include <vector>
+
+#include "algorithms/template_engine.hpp"
+#include "mesh/quad_patch.hpp"
 
 namespace hexrefine {
 
@@ -29,9 +34,14 @@ struct PlacementOptions {
   /// (in (0, 1]): children of a parallelepiped by a box template (1-27, 1-9, 1-3) equal their
   /// parent and are left alone, transition children (1-13: 4/13 of the parent) are not.
   double active_ratio = 0.9;
-  int max_sweeps = 12;  ///< >= 0: Gauss-Seidel sweeps over the active nodes, worst first
+  int max_sweeps = 8;  ///< >= 0: Gauss-Seidel max-min sweeps over the active nodes, worst first
+  /// >= 0: sweeps of the smooth phase first (NodeOptimizerOptions::smooth_sweeps).
+  int smooth_sweeps = 0;
+  /// Layers of children around the active ones whose new nodes may move too (0, 1, ...).
+  int layers = 0;
 };
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementOptions, method, active_ratio, max_sweeps)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementOptions, method, active_ratio, max_sweeps,
+                                                smooth_sweeps, layers)
 
 struct PlacementStats {
   int64_t active_hexes = 0;  ///< children worked on (all passes)
@@ -47,5 +57,37 @@ struct PlacementStats {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementStats, active_hexes, free_nodes,
                                                 nodes_moved, inverted_before, untangled, sweeps,
                                                 min_before, min_after, seconds)
+
+/// The boundary of the input of a refinement (before its first pass) as bilinear patches: where
+/// boundary nodes stay whatever the pass. Patch p is a boundary face of the input, its corners in
+/// the order of topology face_nodes (outward); patches of input hex h are
+/// hex_patches[hex_patch_offsets[h] .. [h+1]).
+struct BoundaryReference {
+  std::vector<Quad> patches;
+  std::vector<int32_t> hex_patch_offsets;
+  std::vector<int32_t> hex_patches;
+};
+
+/// Builds the reference of `input`. Precondition: `topology` built from it (faces at least).
+BoundaryReference boundary_reference_build(const HexMesh& input, const HexTopology& topology);
+
+/// One pass's placement: `current` is the mesh the pass refined (topology `topology`, all parts),
+/// `plan` and `applied` the pass, `original_of` the input hex of each hex of `current` (empty:
+/// `current` is the input), `reference` the input's boundary.
+struct PlacementPass {
+  const HexMesh& current;
+  const HexTopology& topology;
+  const RefinementPlan& plan;
+  const std::vector<int32_t>& first_child;  ///< PlanApplyResult::first_child
+  std::span<const int32_t> original_of;
+  const BoundaryReference& reference;
+  bool allow_inverted = false;
+};
+
+/// Moves the new nodes of `refined` (the pass's output, its nodes from current.point_count() on
+/// new) as PlacementOptions say; accumulates into `stats`. Throws OperationError naming the input
+/// hexes (and their scaled Jacobians) whose children stay inverted, unless allow_inverted.
+void place_new_nodes(const PlacementPass& pass, HexMesh& refined, const PlacementOptions& options,
+                     PlacementStats& stats);
 
 }  // namespace hexrefine

@@ -126,6 +126,7 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
     current = &input_without_parent;
   }
   HexMesh output;
+  BoundaryReference reference;  // the input's boundary, where boundary nodes stay
   std::vector<int32_t> pass_targets = targets.hexes;
   for (int pass = 0; pass < options.passes; ++pass) {
     auto t = Clock::now();
@@ -136,6 +137,22 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
     t = Clock::now();
     PlanApplyResult applied = plan_apply(*current, topology, plan, options.threads);
     stats.phase_seconds["apply"] += seconds_since(t);
+
+    t = Clock::now();
+    if (options.placement.method != PlacementMethod::trilinear) {
+      if (pass == 0) reference = boundary_reference_build(*current, topology);
+      const std::vector<int32_t>* original = mesh_find_attribute(*current, attribute_parent_hex);
+      const PlacementPass placement{
+          *current,
+          topology,
+          plan,
+          applied.first_child,
+          original ? std::span<const int32_t>(*original) : std::span<const int32_t>(),
+          reference,
+          options.allow_inverted};
+      place_new_nodes(placement, applied.mesh, options.placement, stats.placement);
+    }
+    stats.phase_seconds["placement"] += seconds_since(t);
 
     if (pass + 1 < options.passes) {
       // The next pass refines the descendants of this pass's targets (and its transitions'

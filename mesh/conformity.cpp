@@ -10,84 +10,13 @@
 #include <unordered_map>
 
 #include "mesh/hex_convention.hpp"
+#include "mesh/quad_patch.hpp"
 #include "mesh/quality.hpp"
 #include "mesh/topology.hpp"
 
 namespace hexrefine {
 
 namespace {
-
-using Quad = std::array<Eigen::Vector3d, 4>;
-
-/// Point of the bilinear patch through q (q cyclic, q[2] opposite q[0]) at (u, v) in [0,1]^2.
-Eigen::Vector3d quad_point(const Quad& q, double u, double v) {
-  return (1 - u) * (1 - v) * q[0] + u * (1 - v) * q[1] + u * v * q[2] + (1 - u) * v * q[3];
-}
-
-double quad_diameter(const Quad& q) {
-  return std::max((q[2] - q[0]).norm(), (q[3] - q[1]).norm());
-}
-
-/// Area of the bilinear patch: integral of |S_u x S_v| by 3x3 Gauss points (exact for planar
-/// quads, where the integrand is linear; an approximation for warped ones).
-double quad_area(const Quad& q) {
-  static const double nodes[3] = {0.5 - 0.5 * std::sqrt(0.6), 0.5, 0.5 + 0.5 * std::sqrt(0.6)};
-  static const double weights[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
-  double area = 0.0;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      const double u = nodes[i], v = nodes[j];
-      const Eigen::Vector3d su = (1 - v) * (q[1] - q[0]) + v * (q[2] - q[3]);
-      const Eigen::Vector3d sv = (1 - u) * (q[3] - q[0]) + u * (q[2] - q[1]);
-      area += weights[i] * weights[j] * su.cross(sv).norm();
-    }
-  return area;
-}
-
-/// Out-of-plane spread of the four corners along the normal of the diagonals (0 if degenerate).
-double quad_warp(const Quad& q) {
-  const Eigen::Vector3d n = (q[2] - q[0]).cross(q[3] - q[1]);
-  const double n_norm = n.norm();
-  if (!(n_norm > 0.0)) return 0.0;  // collinear diagonals: the points span no plane to leave
-  double lo = 0.0, hi = 0.0;
-  for (int i = 1; i < 4; ++i) {
-    const double d = (q[i] - q[0]).dot(n) / n_norm;
-    lo = std::min(lo, d);
-    hi = std::max(hi, d);
-  }
-  return hi - lo;
-}
-
-/// quad_warp over the diameter.
-double quad_relative_warp(const Quad& q) {
-  const double diameter = quad_diameter(q);
-  return diameter > 0.0 ? quad_warp(q) / diameter : 0.0;
-}
-
-/// Distance from p to the bilinear patch q, by Gauss-Newton on (u, v) clamped to [0,1]^2. Exact
-/// for planar convex quads; for mildly warped quads it converges to the nearest patch point.
-double quad_distance(const Quad& q, const Eigen::Vector3d& p) {
-  double u = 0.5, v = 0.5;
-  for (int iteration = 0; iteration < 30; ++iteration) {
-    const Eigen::Vector3d r = quad_point(q, u, v) - p;
-    const Eigen::Vector3d su = (1 - v) * (q[1] - q[0]) + v * (q[2] - q[3]);
-    const Eigen::Vector3d sv = (1 - u) * (q[3] - q[0]) + u * (q[2] - q[1]);
-    const double a = su.dot(su), b = su.dot(sv), c = sv.dot(sv);
-    const double det = a * c - b * b;
-    if (!(det > 1e-300)) break;
-    const double gu = su.dot(r), gv = sv.dot(r);
-    const double du = -(c * gu - b * gv) / det, dv = -(a * gv - b * gu) / det;
-    const double nu = std::clamp(u + du, 0.0, 1.0), nv = std::clamp(v + dv, 0.0, 1.0);
-    const bool settled = std::abs(nu - u) < 1e-15 && std::abs(nv - v) < 1e-15;
-    u = nu;
-    v = nv;
-    if (settled) break;
-  }
-  double distance = (quad_point(q, u, v) - p).norm();
-  // Degenerate patches (no Newton step) still get an answer: the nearest corner bounds it.
-  for (const Eigen::Vector3d& c : q) distance = std::min(distance, (c - p).norm());
-  return distance;
-}
 
 /// Hash grid over quads: each quad is listed in every cell its bounding box (grown by its
 /// tolerance) overlaps, so a point query looks in one cell only.

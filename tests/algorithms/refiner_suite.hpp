@@ -71,6 +71,14 @@ inline std::function<bool(const Eigen::Vector3d&)> refiner_suite_box(const Eigen
 
 using RefinerFn = std::function<RefineResult(const HexMesh&, const Targets&, const RefineOptions&)>;
 
+/// Options with the thesis' node placement (every new node at its parent's trilinear map of the
+/// template's position): for the tests of the thesis' numbers and of exact geometry.
+inline RefineOptions refine_options_trilinear() {
+  RefineOptions o;
+  o.placement.method = PlacementMethod::trilinear;
+  return o;
+}
+
 struct RefinerSuiteCase {
   std::string name;
   HexMesh mesh;

@@ -1,6 +1,7 @@
 #include "algorithms/selective.hpp"
 #include "algorithms/sheet.hpp"
 #include "algorithms/smoothing.hpp"
+#include "tests/algorithms/refiner_suite.hpp"
 
 #include <gtest/gtest.h>
 
@@ -348,7 +349,7 @@ TEST_P(SmoothingMethods, LShapedSelectiveRefinementThenSmoothing) {
     for (int j = 0; j < 10; ++j)
       for (int i = 0; i < 10; ++i)
         if (i == 0 || k == 0) targets.hexes.push_back(fixture_brick_hex(10, 10, i, j, k));
-  const RefineResult refined = selective_refine(brick, targets, {});
+  const RefineResult refined = selective_refine(brick, targets, refine_options_trilinear());
   const HexMesh& input = refined.mesh;
   HexMesh m = input;
   SmoothOptions o;

@@ -1,0 +1,97 @@
+#pragma once
+/// \file
+/// Local node optimization shared by node placement (node_placement.hpp) and smoothing
+/// (smoothing.hpp): a set of movable nodes, the hexes around each, how each may move (freely, on
+/// a bilinear patch of the input's boundary, along a straight boundary edge, or on a union of
+/// them), and Gauss-Seidel sweeps that move one node at a time to raise the worst scaled Jacobian
+/// of the hexes around it. See node_optimizer.cpp for the objective and its sources.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "mesh/hex_mesh.hpp"
+#include "mesh/quad_patch.hpp"
+
+namespace hexrefine {
+
+/// How a movable node may move.
+enum class SlideKind : uint8_t {
+  free,      ///< anywhere: a node inside the domain
+  patch,     ///< on one bilinear patch (a quad of the input's boundary), (u, v) in [0,1]^2
+  segment,   ///< on one straight segment (an edge of the input's boundary), t in [0,1]
+  patches,   ///< on the union of several patches (the boundary quads around a node)
+  segments,  ///< on the union of several segments (a feature curve's edges around a node)
+};
+
+/// The slide of one node: its kind and its patches or segments (SlideGeometry::items[first ..
+/// first + count)).
+struct NodeSlide {
+  SlideKind kind = SlideKind::free;
+  int32_t first = 0, count = 0;
+};
+
+/// What nodes slide on: reference positions, fixed while the nodes move.
+struct SlideGeometry {
+  std::vector<Quad> patches;
+  std::vector<std::array<Eigen::Vector3d, 2>> segments;
+  std::vector<int32_t> items;  ///< patch or segment ids of the slides
+};
+
+/// A local problem: movable nodes, how each slides, the hexes around each.
+struct NodeProblem {
+  std::vector<int32_t> nodes;             ///< movable nodes (ids into mesh.points), ascending
+  std::vector<NodeSlide> slides;          ///< per movable node
+  std::vector<int32_t> hexes;             ///< every hex around a movable node, ascending, unique
+  std::vector<int32_t> node_hex_offsets;  ///< CSR: movable node i -> indices into `hexes`
+  std::vector<int32_t> node_hex;
+  SlideGeometry geometry;
+};
+
+/// Fills problem.hexes and the node -> hex CSR from `candidates` (ascending hex ids that include
+/// every hex with a movable node; others are skipped). Linear in the candidates; uses one int32
+/// per mesh node as scratch. Precondition: problem.nodes ascending.
+void node_problem_connect(NodeProblem& problem, const HexMesh& mesh,
+                          const std::vector<int32_t>& candidates);
+
+struct NodeOptimizerOptions {
+  /// Also try the mean of the node's edge neighbours, as a full, half and quarter move (Freitag's
+  /// smart Laplacian), and one Newton step on the inverse mean ratio (Knupp), before the ascent.
+  bool laplacian_and_mean_ratio = false;
+  /// Never turn a hex with a positive scaled Jacobian non-positive (smoothing). false: an
+  /// inverted hex may be traded for a less inverted one while untangling (placement), as long
+  /// as the worst hex around the node improves.
+  bool keep_positive = true;
+  int max_sweeps = 12;   ///< >= 0
+  int ascent_steps = 4;  ///< ascent steps per node visit
+  /// Sweeps of a first, smooth phase before the max-min sweeps: ascent of the KS soft minimum with
+  /// a low beta (it weighs every sample around the node, not only the worst), a move kept when
+  /// that soft minimum rises. Nodes then move together towards a balanced configuration that
+  /// one-node max-min steps cannot reach from a poor start (the transition nodes of a template
+  /// in a long parent). The problem's minimum is restored if this phase lowered it.
+  int smooth_sweeps = 0;
+  double smooth_beta = 8.0;
+};
+
+struct NodeOptimizerStats {
+  int sweeps = 0;
+  int64_t nodes_moved = 0;  ///< movable nodes whose position changed
+  /// Minimum and mean scaled Jacobian over problem.hexes before and after (1 if none).
+  double min_before = 1, min_after = 1, mean_before = 1, mean_after = 1;
+};
+
+/// Moves problem.nodes in `mesh` (see the file comment); deterministic (worst-first order with
+/// ties by node id, serial). The minimum over problem.hexes never decreases.
+NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
+                                  const NodeOptimizerOptions& options);
+
+/// Gradients of the nine scaled-Jacobian samples of a hex (hex_scaled_jacobian_samples: corners
+/// 0..7, then the centre) with respect to the position of its local vertex `vertex`.
+/// Sample s = det(A) / (|a0| |a1| |a2|), column k of A = c_k x + const (c_k in {-1, -1/4, 0,
+/// 1/4, 1}): ds/dx = sum_k c_k (cof_k / L - s a_k / |a_k|^2), cof_k the cofactor column
+/// (a1 x a2, a2 x a0, a0 x a1), L the product of the column lengths; zero where L is 0.
+void hex_scaled_jacobian_gradients(const std::array<Eigen::Vector3d, 8>& corners, int vertex,
+                                   std::array<double, 9>& samples,
+                                   std::array<Eigen::Vector3d, 9>& gradients);
+
+}  // namespace hexrefine

@@ -1,0 +1,338 @@
+/// \file
+/// Node placement: after the engine has applied a pass (every new node at its parent's trilinear
+/// map of the template's reference position, the thesis' placement), move the new nodes around
+/// poor children to raise the worst scaled Jacobian around them, untangling inverted children
+/// first. The templates' fixed reference positions do not suit anisotropic or distorted parents
+/// (a 1-13 in a hex three times longer than wide, the children of a skewed CAD hex); where a node
+/// goes never decides which nodes exist.
+///
+/// Objective and optimizer (node_optimizer.cpp): per node, the max-min problem of Freitag and
+/// Plassmann (IJNME 49, 2000) on the scaled Jacobian of the hexes around the node (Verdict's
+/// definition, mesh/quality.hpp), solved by ascent of its Kreisselmeier-Steinhauser soft minimum
+/// with analytic gradients; a move is kept only if the worst hex around the node improves, so
+/// the minimum never drops; the scaled Jacobian is signed, so the same problem untangles.
+///
+/// Steps of one pass:
+///  1. Active children: those whose scaled Jacobian is below PlacementOptions::active_ratio
+///     times their parent's, or not positive. Children of a parallelepiped by a template of
+///     boxes equal their parent and are skipped without evaluating them.
+///  2. Free nodes: the new nodes of active children. From the template node that made each
+///     (entity and local index in its parent): strictly inside the parent, or on an interior
+///     face or edge of the refined mesh: free (both sides share the node, so conformity holds);
+///     on a boundary face: slides on the input's boundary patch that holds it (its bilinear
+///     patch, (u, v) in [0,1]^2); on a boundary edge: slides along the input patch edge that
+///     holds it, or on the input patch if the edge lies inside one (a later pass's edge); input
+///     nodes never move. So boundary nodes stay on the input's boundary surface, in the input
+///     face they subdivide (the checker's conformity against the input still holds).
+///  3. The problem is local: the hexes around the free nodes are the children of the parents
+///     around the active ones (node neighbours in the refined mesh), gathered without building
+///     the output's topology. Serial, worst node first, ties by id: the same result for any
+///     --threads.
+///  4. A child of a valid parent still inverted after the sweeps is a refusal (OperationError
+///     naming the input hexes and their scaled Jacobians), unless allow_inverted.
+
+#include "algorithms/node_placement.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <unordered_map>
+
+#include "algorithms/node_optimizer.hpp"
+#include "mesh/error.hpp"
+#include "mesh/hex_convention.hpp"
+#include "mesh/quality.hpp"
+
+namespace hexrefine {
+
+namespace {
+
+/// Every child of the template is an axis-aligned box of the reference cube: its image under an
+/// affine parent has the parent's scaled Jacobian.
+bool template_is_boxes(const HexTemplate& t) {
+  for (const auto& child : t.children)
+    for (int e = 0; e < 12; ++e) {
+      const auto& a = t.nodes[child[hex_edges[e][0]]].ref;
+      const auto& b = t.nodes[child[hex_edges[e][1]]].ref;
+      int moving = 0;
+      for (int k = 0; k < 3; ++k) moving += std::abs(a[k] - b[k]) > 1e-12;
+      if (moving != 1) return false;
+    }
+  return true;
+}
+
+/// The template node behind a new node: the use, and the plan node of its first active child.
+struct NodeOrigin {
+  int32_t use = -1;
+  int16_t plan_node = -1;
+};
+
+}  // namespace
+
+std::string_view placement_method_name(PlacementMethod m) {
+  return m == PlacementMethod::trilinear ? "trilinear" : "optimized";
+}
+
+BoundaryReference boundary_reference_build(const HexMesh& input, const HexTopology& t) {
+  BoundaryReference r;
+  r.hex_patch_offsets.assign(static_cast<size_t>(input.hex_count()) + 1, 0);
+  std::vector<int32_t> patch_of_face(t.face_count(), -1);
+  for (int32_t f = 0; f < t.face_count(); ++f) {
+    if (!face_is_boundary(t, f)) continue;
+    patch_of_face[f] = static_cast<int32_t>(r.patches.size());
+    const auto& n = t.face_nodes[f];
+    r.patches.push_back(
+        {input.points[n[0]], input.points[n[1]], input.points[n[2]], input.points[n[3]]});
+    ++r.hex_patch_offsets[t.face_hexes[f][0] + 1];
+  }
+  for (int32_t h = 0; h < input.hex_count(); ++h)
+    r.hex_patch_offsets[h + 1] += r.hex_patch_offsets[h];
+  r.hex_patches.resize(r.patches.size());
+  std::vector<int32_t> cursor(r.hex_patch_offsets.begin(), r.hex_patch_offsets.end() - 1);
+  for (int32_t f = 0; f < t.face_count(); ++f)
+    if (patch_of_face[f] >= 0) r.hex_patches[cursor[t.face_hexes[f][0]]++] = patch_of_face[f];
+  return r;
+}
+
+void place_new_nodes(const PlacementPass& pass, HexMesh& refined, const PlacementOptions& options,
+                     PlacementStats& stats) {
+  if (options.method == PlacementMethod::trilinear) return;
+  const auto start = std::chrono::steady_clock::now();
+  const HexMesh& current = pass.current;
+  const HexTopology& topology = pass.topology;
+  const int32_t old_nodes = current.point_count();
+  const auto& uses = pass.plan.uses;
+  auto original = [&](int32_t h) { return pass.original_of.empty() ? h : pass.original_of[h]; };
+
+  // 1. Active children.
+  std::unordered_map<const HexTemplate*, bool> boxes;
+  std::vector<int32_t> active;  // output hexes
+  std::vector<int32_t> active_use;
+  std::vector<uint8_t> use_active(uses.size(), 0);
+  std::vector<double> parent_quality(uses.size(), 1.0);
+  for (size_t u = 0; u < uses.size(); ++u) {
+    const int32_t h = index_of(uses[u].hex);
+    const HexCorners x = hex_points(current, h);
+    const auto [it, inserted] = boxes.try_emplace(uses[u].tmpl, false);
+    if (inserted) it->second = template_is_boxes(*uses[u].tmpl);
+    if (it->second && hex_is_parallelepiped(x)) continue;
+    const double parent = hex_scaled_jacobian(x);
+    parent_quality[u] = parent;
+    const int32_t first = pass.first_child[u];
+    const int32_t count = static_cast<int32_t>(uses[u].tmpl->children.size());
+    for (int32_t c = first; c < first + count; ++c) {
+      const double q = hex_scaled_jacobian(hex_points(refined, c));
+      if (q < options.active_ratio * parent || !(q > 0)) {
+        active.push_back(c);
+        active_use.push_back(static_cast<int32_t>(u));
+        use_active[u] = 1;
+        stats.inverted_before += !(q > 0);
+        stats.min_before = std::min(stats.min_before, q);
+      }
+    }
+  }
+  stats.active_hexes += static_cast<int64_t>(active.size());
+  if (active.empty()) return;
+
+  // The hexes around the free nodes: children of the parents node-adjacent to the active ones
+  // (a new node lies on its parent's closure, so every hex holding it is a child of a parent
+  // sharing a node with that parent), one ring more per layer of nodes added below.
+  std::vector<int32_t> candidates, candidate_use;
+  {
+    std::vector<int32_t> use_of_hex(current.hex_count(), -1);
+    for (size_t u = 0; u < uses.size(); ++u)
+      use_of_hex[index_of(uses[u].hex)] = static_cast<int32_t>(u);
+    std::vector<uint8_t> taken(uses.size(), 0);
+    std::vector<int32_t> near_uses, ring;
+    for (size_t u = 0; u < uses.size(); ++u)
+      if (use_active[u]) ring.push_back(static_cast<int32_t>(u));
+    for (int step = 0; step <= options.layers; ++step) {
+      std::vector<int32_t> next;
+      for (int32_t u : ring)
+        for (int32_t v : current.hexes[index_of(uses[u].hex)])
+          for (int32_t g : node_hexes(topology, v)) {
+            const int32_t w = use_of_hex[g];
+            if (w >= 0 && !taken[w]) {
+              taken[w] = 1;
+              near_uses.push_back(w);
+              next.push_back(w);
+            }
+          }
+      ring = std::move(next);
+    }
+    std::sort(near_uses.begin(), near_uses.end());
+    for (int32_t u : near_uses)
+      for (int32_t c = pass.first_child[u];
+           c < pass.first_child[u] + static_cast<int32_t>(uses[u].tmpl->children.size()); ++c) {
+        candidates.push_back(c);
+        candidate_use.push_back(u);
+      }
+  }
+
+  // 2. Free nodes and where each came from.
+  std::unordered_map<int32_t, NodeOrigin> origin_of;
+  for (size_t a = 0; a < active.size(); ++a) {
+    const int32_t u = active_use[a];
+    const TemplatePlan& plan = uses[u].tmpl->plans[uses[u].symmetry];
+    const int32_t child = active[a] - pass.first_child[u];
+    for (int k = 0; k < 8; ++k) {
+      const int32_t node = refined.hexes[active[a]][k];
+      if (node < old_nodes) continue;
+      origin_of.try_emplace(node, NodeOrigin{u, plan.children[child][k]});
+    }
+  }
+  // The new nodes of the children around them may move too (PlacementOptions::layers): a poor
+  // child often needs its neighbours to give way.
+  for (int layer = 0; layer < options.layers; ++layer) {
+    std::vector<std::pair<int32_t, NodeOrigin>> added;
+    for (size_t k = 0; k < candidates.size(); ++k) {
+      const HexCell& c = refined.hexes[candidates[k]];
+      bool touches = false;
+      for (int32_t v : c) touches = touches || origin_of.count(v);
+      if (!touches) continue;
+      const int32_t u = candidate_use[k];
+      const TemplatePlan& plan = uses[u].tmpl->plans[uses[u].symmetry];
+      const int32_t child = candidates[k] - pass.first_child[u];
+      for (int v = 0; v < 8; ++v)
+        if (c[v] >= old_nodes && !origin_of.count(c[v]))
+          added.push_back({c[v], NodeOrigin{u, plan.children[child][v]}});
+    }
+    for (const auto& [node, o] : added) origin_of.try_emplace(node, o);
+  }
+  NodeProblem problem;
+  for (const auto& [node, o] : origin_of) problem.nodes.push_back(node);
+  std::sort(problem.nodes.begin(), problem.nodes.end());
+  SlideGeometry& geometry = problem.geometry;
+  std::unordered_map<int32_t, int32_t> segment_of_rim;  // patch * 4 + side -> segment id
+  for (int32_t node : problem.nodes) {
+    const NodeOrigin& o = origin_of.at(node);
+    const TemplateUse& use = uses[o.use];
+    const int32_t h = index_of(use.hex);
+    const TemplatePlanNode& pn = use.tmpl->plans[use.symmetry].nodes[o.plan_node];
+    // Candidate input patches: those of the input hexes around the node's entity.
+    std::vector<int32_t> around;
+    if (pn.entity == CubeEntity::face) {
+      const int32_t f = topology.hex_face_ids[h][pn.local];
+      if (face_is_boundary(topology, f)) around.push_back(h);
+    } else if (pn.entity == CubeEntity::edge) {
+      const int32_t e = topology.hex_edge_ids[h][pn.local];
+      if (edge_is_boundary(topology, e))
+        for (int32_t g : edge_hexes(topology, e)) around.push_back(g);
+    }
+    NodeSlide slide;
+    if (!around.empty()) {
+      const Eigen::Vector3d& x = refined.points[node];
+      int32_t best = -1;
+      QuadProjection best_projection;
+      for (int32_t g : around) {
+        const int32_t o_hex = original(g);
+        for (int32_t k = pass.reference.hex_patch_offsets[o_hex];
+             k < pass.reference.hex_patch_offsets[o_hex + 1]; ++k) {
+          const int32_t p = pass.reference.hex_patches[k];
+          const QuadProjection q = quad_closest_point(pass.reference.patches[p], x);
+          if (best < 0 || q.distance < best_projection.distance) {
+            best = p;
+            best_projection = q;
+          }
+        }
+      }
+      if (best < 0) {
+        slide.kind = SlideKind::segment;  // no patch found: keep it where it is
+        slide.count = 0;
+      } else {
+        constexpr double rim = 1e-9;
+        const bool u_rim = best_projection.u < rim || best_projection.u > 1 - rim;
+        const bool v_rim = best_projection.v < rim || best_projection.v > 1 - rim;
+        slide.first = static_cast<int32_t>(geometry.items.size());
+        slide.count = 1;
+        if (!u_rim && !v_rim) {
+          slide.kind = SlideKind::patch;
+          geometry.items.push_back(best);
+        } else if (u_rim && v_rim) {
+          slide.kind = SlideKind::segment;  // at a patch corner: fixed
+          slide.count = 0;
+        } else {
+          // The patch side the node lies on: v = 0 (q0 q1), u = 1 (q1 q2), v = 1 (q2 q3),
+          // u = 0 (q3 q0).
+          const int side =
+              v_rim ? (best_projection.v < 0.5 ? 0 : 2) : (best_projection.u > 0.5 ? 1 : 3);
+          const Quad& q = pass.reference.patches[best];
+          const auto [it, inserted] = segment_of_rim.try_emplace(
+              4 * best + side, static_cast<int32_t>(geometry.segments.size()));
+          if (inserted) geometry.segments.push_back({q[side], q[(side + 1) % 4]});
+          slide.kind = SlideKind::segment;
+          geometry.items.push_back(it->second);
+        }
+      }
+    }
+    problem.slides.push_back(slide);
+  }
+  // Patches are referenced by input id: copy the ones used.
+  {
+    std::unordered_map<int32_t, int32_t> local_patch;
+    for (size_t i = 0; i < problem.slides.size(); ++i) {
+      NodeSlide& s = problem.slides[i];
+      if (s.kind != SlideKind::patch) continue;
+      int32_t& item = geometry.items[s.first];
+      const auto [it, inserted] =
+          local_patch.try_emplace(item, static_cast<int32_t>(geometry.patches.size()));
+      if (inserted) geometry.patches.push_back(pass.reference.patches[item]);
+      item = it->second;
+    }
+  }
+  // A node fixed where it is (segment slide without items) is not movable.
+  {
+    NodeProblem movable;
+    movable.geometry = std::move(problem.geometry);
+    for (size_t i = 0; i < problem.nodes.size(); ++i) {
+      if (problem.slides[i].kind == SlideKind::segment && problem.slides[i].count == 0) continue;
+      movable.nodes.push_back(problem.nodes[i]);
+      movable.slides.push_back(problem.slides[i]);
+    }
+    problem = std::move(movable);
+  }
+  stats.free_nodes += static_cast<int64_t>(problem.nodes.size());
+
+  node_problem_connect(problem, refined, candidates);
+
+  NodeOptimizerOptions optimizer;
+  optimizer.keep_positive = false;
+  optimizer.max_sweeps = options.max_sweeps;
+  optimizer.smooth_sweeps = options.smooth_sweeps;
+  const NodeOptimizerStats run = nodes_optimize(refined, problem, optimizer);
+  stats.sweeps = std::max(stats.sweeps, run.sweeps);
+  stats.nodes_moved += run.nodes_moved;
+
+  // 4. What is left inverted.
+  std::vector<int32_t> failed;
+  for (size_t a = 0; a < active.size(); ++a) {
+    const double q = hex_scaled_jacobian(hex_points(refined, active[a]));
+    stats.min_after = std::min(stats.min_after, q);
+    const int32_t u = active_use[a];
+    const bool was_inverted = parent_quality[u] > 0;  // a valid parent's child
+    if (q > 0) continue;
+    if (was_inverted) failed.push_back(u);
+  }
+  int64_t still_inverted = 0;
+  for (size_t a = 0; a < active.size(); ++a)
+    still_inverted += !(hex_scaled_jacobian(hex_points(refined, active[a])) > 0);
+  stats.untangled += std::max<int64_t>(0, stats.inverted_before - still_inverted);
+  stats.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (failed.empty() || pass.allow_inverted) return;
+  std::sort(failed.begin(), failed.end());
+  failed.erase(std::unique(failed.begin(), failed.end()), failed.end());
+  std::string list;
+  for (size_t i = 0; i < failed.size() && i < 10; ++i) {
+    const int32_t h = index_of(uses[failed[i]].hex);
+    list += (i ? ", " : "") + std::to_string(original(h)) + " (" +
+            std::to_string(parent_quality[failed[i]]) + ")";
+  }
+  throw OperationError(
+      "node placement: no placement of the new nodes gives every child a "
+      "positive scaled Jacobian in input hexes (scaled Jacobian) " +
+      list + (failed.size() > 10 ? ", ..." : "") +
+      "; they are too distorted for the templates they need");
+}
+
+}  // namespace hexrefine

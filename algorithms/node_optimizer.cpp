@@ -18,10 +18,11 @@
 ///   kept only if the local quality does not get worse), optimization only where it does not
 ///   suffice.
 ///
-/// Per visit of a node (positions of the other nodes fixed):
-///  1. (smoothing only) the Laplacian candidate, tried as a full, half and quarter move, then
-///     one damped Newton step on the sum of inverse mean ratios of the corner matrices that
-///     depend on a free node;
+/// Per visit of a node (positions of the other nodes fixed; nodes whose worst hex is already at
+/// or above visit_below are not visited):
+///  1. (smoothing) the Laplacian candidate, tried as a full, half and quarter move, then one
+///     damped Newton step on the sum of inverse mean ratios of the corner matrices that depend on
+///     a free node;
 ///  2. ascent of the KS soft minimum of the nine scaled-Jacobian samples of every hex around
 ///     the node (analytic gradients: hex_scaled_jacobian_gradients), the gradient projected onto
 ///     the node's slide (the tangent plane of its patch, the direction of its segment), a step
@@ -172,11 +173,10 @@ class Optimizer {
   /// Visits local node i once; returns the distance it moved.
   double visit(int32_t i) {
     const Vec3 before = mesh_.points[problem_.nodes[i]];
-    if (options_.laplacian_and_mean_ratio) {
-      laplacian(i);
-      mean_ratio_newton(i);
-    }
-    ascent(i);
+    if (!(local_min(i) < options_.visit_below)) return 0.0;
+    if (options_.laplacian) laplacian(i);
+    if (options_.mean_ratio) mean_ratio_newton(i);
+    if (options_.ascent) ascent(i);
     return (mesh_.points[problem_.nodes[i]] - before).norm();
   }
 

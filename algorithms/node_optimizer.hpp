@@ -55,9 +55,15 @@ void node_problem_connect(NodeProblem& problem, const HexMesh& mesh,
                           const std::vector<int32_t>& candidates);
 
 struct NodeOptimizerOptions {
-  /// Also try the mean of the node's edge neighbours, as a full, half and quarter move (Freitag's
-  /// smart Laplacian), and one Newton step on the inverse mean ratio (Knupp), before the ascent.
-  bool laplacian_and_mean_ratio = false;
+  /// Try the mean of the node's edge neighbours, as a full, half and quarter move (Freitag's
+  /// smart Laplacian).
+  bool laplacian = false;
+  /// Then one Newton step on the inverse mean ratio (Knupp; free nodes).
+  bool mean_ratio = false;
+  /// Then the max-min ascent of the scaled Jacobian around the node.
+  bool ascent = true;
+  /// Nodes whose worst hex is at or above this are not visited (in (0, 1]; 1: every node).
+  double visit_below = 1.0;
   /// Never turn a hex with a positive scaled Jacobian non-positive (smoothing). false: an
   /// inverted hex may be traded for a less inverted one while untangling (placement), as long
   /// as the worst hex around the node improves.

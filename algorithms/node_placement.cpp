@@ -70,6 +70,47 @@ struct NodeOrigin {
 
 }  // namespace
 
+std::optional<NodeSlide> ReferenceSlides::at(const Eigen::Vector3d& x,
+                                             std::span<const int32_t> input_hexes) {
+  int32_t best = -1;
+  QuadProjection projection;
+  for (int32_t h : input_hexes)
+    for (int32_t k = reference_.hex_patch_offsets[h]; k < reference_.hex_patch_offsets[h + 1];
+         ++k) {
+      const int32_t p = reference_.hex_patches[k];
+      const QuadProjection q = quad_closest_point(reference_.patches[p], x);
+      if (best < 0 || q.distance < projection.distance) {
+        best = p;
+        projection = q;
+      }
+    }
+  if (best < 0) return std::nullopt;
+  constexpr double rim = 1e-9;
+  const bool u_rim = projection.u < rim || projection.u > 1 - rim;
+  const bool v_rim = projection.v < rim || projection.v > 1 - rim;
+  if (u_rim && v_rim) return std::nullopt;
+  NodeSlide slide;
+  slide.first = static_cast<int32_t>(geometry_.items.size());
+  slide.count = 1;
+  if (!u_rim && !v_rim) {
+    slide.kind = SlideKind::patch;
+    const auto [it, inserted] =
+        patch_copy_.try_emplace(best, static_cast<int32_t>(geometry_.patches.size()));
+    if (inserted) geometry_.patches.push_back(reference_.patches[best]);
+    geometry_.items.push_back(it->second);
+    return slide;
+  }
+  // The patch side: v = 0 (q0 q1), u = 1 (q1 q2), v = 1 (q2 q3), u = 0 (q3 q0).
+  const int side = v_rim ? (projection.v < 0.5 ? 0 : 2) : (projection.u > 0.5 ? 1 : 3);
+  const Quad& q = reference_.patches[best];
+  const auto [it, inserted] =
+      rim_segment_.try_emplace(4 * best + side, static_cast<int32_t>(geometry_.segments.size()));
+  if (inserted) geometry_.segments.push_back({q[side], q[(side + 1) % 4]});
+  slide.kind = SlideKind::segment;
+  geometry_.items.push_back(it->second);
+  return slide;
+}
+
 std::string_view placement_method_name(PlacementMethod m) {
   return m == PlacementMethod::trilinear ? "trilinear" : "optimized";
 }
@@ -201,96 +242,36 @@ void place_new_nodes(const PlacementPass& pass, HexMesh& refined, const Placemen
     for (const auto& [node, o] : added) origin_of.try_emplace(node, o);
   }
   NodeProblem problem;
-  for (const auto& [node, o] : origin_of) problem.nodes.push_back(node);
-  std::sort(problem.nodes.begin(), problem.nodes.end());
-  SlideGeometry& geometry = problem.geometry;
-  std::unordered_map<int32_t, int32_t> segment_of_rim;  // patch * 4 + side -> segment id
-  for (int32_t node : problem.nodes) {
-    const NodeOrigin& o = origin_of.at(node);
-    const TemplateUse& use = uses[o.use];
-    const int32_t h = index_of(use.hex);
-    const TemplatePlanNode& pn = use.tmpl->plans[use.symmetry].nodes[o.plan_node];
-    // Candidate input patches: those of the input hexes around the node's entity.
+  {
+    std::vector<int32_t> nodes;
+    for (const auto& [node, o] : origin_of) nodes.push_back(node);
+    std::sort(nodes.begin(), nodes.end());
+    ReferenceSlides slides(pass.reference, problem.geometry);
     std::vector<int32_t> around;
-    if (pn.entity == CubeEntity::face) {
-      const int32_t f = topology.hex_face_ids[h][pn.local];
-      if (face_is_boundary(topology, f)) around.push_back(h);
-    } else if (pn.entity == CubeEntity::edge) {
-      const int32_t e = topology.hex_edge_ids[h][pn.local];
-      if (edge_is_boundary(topology, e))
-        for (int32_t g : edge_hexes(topology, e)) around.push_back(g);
-    }
-    NodeSlide slide;
-    if (!around.empty()) {
-      const Eigen::Vector3d& x = refined.points[node];
-      int32_t best = -1;
-      QuadProjection best_projection;
-      for (int32_t g : around) {
-        const int32_t o_hex = original(g);
-        for (int32_t k = pass.reference.hex_patch_offsets[o_hex];
-             k < pass.reference.hex_patch_offsets[o_hex + 1]; ++k) {
-          const int32_t p = pass.reference.hex_patches[k];
-          const QuadProjection q = quad_closest_point(pass.reference.patches[p], x);
-          if (best < 0 || q.distance < best_projection.distance) {
-            best = p;
-            best_projection = q;
-          }
-        }
+    for (int32_t node : nodes) {
+      const NodeOrigin& o = origin_of.at(node);
+      const TemplateUse& use = uses[o.use];
+      const int32_t h = index_of(use.hex);
+      const TemplatePlanNode& pn = use.tmpl->plans[use.symmetry].nodes[o.plan_node];
+      // On the boundary of the refined mesh: the input hexes around the node's entity.
+      around.clear();
+      if (pn.entity == CubeEntity::face) {
+        if (face_is_boundary(topology, topology.hex_face_ids[h][pn.local]))
+          around.push_back(original(h));
+      } else if (pn.entity == CubeEntity::edge) {
+        const int32_t e = topology.hex_edge_ids[h][pn.local];
+        if (edge_is_boundary(topology, e))
+          for (int32_t g : edge_hexes(topology, e)) around.push_back(original(g));
       }
-      if (best < 0) {
-        slide.kind = SlideKind::segment;  // no patch found: keep it where it is
-        slide.count = 0;
-      } else {
-        constexpr double rim = 1e-9;
-        const bool u_rim = best_projection.u < rim || best_projection.u > 1 - rim;
-        const bool v_rim = best_projection.v < rim || best_projection.v > 1 - rim;
-        slide.first = static_cast<int32_t>(geometry.items.size());
-        slide.count = 1;
-        if (!u_rim && !v_rim) {
-          slide.kind = SlideKind::patch;
-          geometry.items.push_back(best);
-        } else if (u_rim && v_rim) {
-          slide.kind = SlideKind::segment;  // at a patch corner: fixed
-          slide.count = 0;
-        } else {
-          // The patch side the node lies on: v = 0 (q0 q1), u = 1 (q1 q2), v = 1 (q2 q3),
-          // u = 0 (q3 q0).
-          const int side =
-              v_rim ? (best_projection.v < 0.5 ? 0 : 2) : (best_projection.u > 0.5 ? 1 : 3);
-          const Quad& q = pass.reference.patches[best];
-          const auto [it, inserted] = segment_of_rim.try_emplace(
-              4 * best + side, static_cast<int32_t>(geometry.segments.size()));
-          if (inserted) geometry.segments.push_back({q[side], q[(side + 1) % 4]});
-          slide.kind = SlideKind::segment;
-          geometry.items.push_back(it->second);
-        }
+      NodeSlide slide;
+      if (!around.empty()) {
+        const std::optional<NodeSlide> s = slides.at(refined.points[node], around);
+        if (!s) continue;  // at an input patch corner: stays
+        slide = *s;
       }
+      problem.nodes.push_back(node);
+      problem.slides.push_back(slide);
     }
-    problem.slides.push_back(slide);
-  }
-  // Patches are referenced by input id: copy the ones used.
-  {
-    std::unordered_map<int32_t, int32_t> local_patch;
-    for (size_t i = 0; i < problem.slides.size(); ++i) {
-      NodeSlide& s = problem.slides[i];
-      if (s.kind != SlideKind::patch) continue;
-      int32_t& item = geometry.items[s.first];
-      const auto [it, inserted] =
-          local_patch.try_emplace(item, static_cast<int32_t>(geometry.patches.size()));
-      if (inserted) geometry.patches.push_back(pass.reference.patches[item]);
-      item = it->second;
-    }
-  }
-  // A node fixed where it is (segment slide without items) is not movable.
-  {
-    NodeProblem movable;
-    movable.geometry = std::move(problem.geometry);
-    for (size_t i = 0; i < problem.nodes.size(); ++i) {
-      if (problem.slides[i].kind == SlideKind::segment && problem.slides[i].count == 0) continue;
-      movable.nodes.push_back(problem.nodes[i]);
-      movable.slides.push_back(problem.slides[i]);
-    }
-    problem = std::move(movable);
   }
   stats.free_nodes += static_cast<int64_t>(problem.nodes.size());
 

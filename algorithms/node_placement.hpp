@@ -5,10 +5,13 @@
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <span>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
+#include "algorithms/node_optimizer.hpp"
 #include "algorithms/template_engine.hpp"
 #include "mesh/quad_patch.hpp"
 
@@ -70,6 +73,27 @@ struct BoundaryReference {
 
 /// Builds the reference of `input`. Precondition: `topology` built from it (faces at least).
 BoundaryReference boundary_reference_build(const HexMesh& input, const HexTopology& topology);
+
+/// Slides on the input's boundary for nodes of a refined mesh, collected into one geometry (the
+/// patches and segments copied once each).
+class ReferenceSlides {
+ public:
+  ReferenceSlides(const BoundaryReference& reference, SlideGeometry& geometry)
+      : reference_(reference), geometry_(geometry) {}
+
+  /// The slide of a node at x on the boundary of the input hexes `input_hexes` (those of the
+  /// refined hexes around it): on the nearest of their input patches, strictly inside it (a
+  /// patch slide), on one of its sides (a segment slide along that side, which two input faces
+  /// share or which is the rim of the boundary), or nullopt at a patch corner or when no patch
+  /// is found (the node stays).
+  std::optional<NodeSlide> at(const Eigen::Vector3d& x, std::span<const int32_t> input_hexes);
+
+ private:
+  const BoundaryReference& reference_;
+  SlideGeometry& geometry_;
+  std::unordered_map<int32_t, int32_t> patch_copy_;   ///< input patch -> geometry patch
+  std::unordered_map<int32_t, int32_t> rim_segment_;  ///< input patch * 4 + side -> segment
+};
 
 /// One pass's placement: `current` is the mesh the pass refined (topology `topology`, all parts),
 /// `plan` and `applied` the pass, `original_of` the input hex of each hex of `current` (empty:

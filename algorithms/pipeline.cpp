@@ -146,11 +146,15 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
     SmoothOptions so = o.smoothing;
     so.region_hexes = mesh_refined_hexes(r.mesh);
     if (!so.region_hexes.empty()) {
+      // Boundary nodes the refinement made slide within the input face or edge they subdivide,
+      // the input's boundary nodes stay: the smoothed mesh is checked against the input again.
+      const BoundaryReference reference =
+          boundary_reference_build(input, topology_build(input, TopologyParts::faces));
+      so.reference = &reference;
+      so.reference_nodes = input.point_count();
       r.smoothing = mesh_smooth(r.mesh, so);
       clock.end("smooth");
-      // Smoothing slides boundary nodes within planar faces: the smoothed mesh no longer
-      // subdivides the input's faces exactly, so it is checked on its own.
-      r.smoothed_check = mesh_check(r.mesh);
+      r.smoothed_check = mesh_check(r.mesh, &input);
       clock.end("check_smoothed");
       verdict_enforce(*r.smoothed_check, r.mesh, input, o, r.ablation, "smoothing");
     }

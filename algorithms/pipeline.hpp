@@ -13,8 +13,9 @@
 /// checker (bad input, not a refiner failure), OperationError otherwise, naming the defects and
 /// the input hexes they descend from; nothing is returned or written. With an ablation switch the
 /// result may be non-conformal by design and is returned with the checker's counts.
-/// Smoothing (optional) moves the refined region's nodes (algorithms/smoothing.hpp) and is
-/// checked again the same way.
+/// Smoothing (optional) moves the nodes of the refined region and two layers around it
+/// (algorithms/smoothing.hpp), boundary nodes within the input faces they subdivide, and the
+/// result is checked against the input again the same way.
 
 #include <cstdint>
 #include <iosfwd>
@@ -33,6 +34,13 @@
 
 namespace hexrefine {
 
+/// SmoothOptions with two layers around the refined region.
+inline SmoothOptions pipeline_smoothing_defaults() {
+  SmoothOptions o;
+  o.layers = 2;
+  return o;
+}
+
 struct PipelineOptions {
   std::string method = "selective";  ///< a name of refine_methods()
   /// Selection specs (mesh/selection.hpp), united; ignored when `targets` is set.
@@ -40,7 +48,9 @@ struct PipelineOptions {
   std::optional<std::vector<int32_t>> targets;  ///< explicit target hex ids instead of `select`
   RefineOptions refine;
   bool smooth = false;
-  SmoothOptions smoothing;  ///< its region_hexes is replaced by the refined hexes
+  /// How to smooth: the region is the refined hexes (region_hexes is replaced) and two layers
+  /// around them; the reference is the input.
+  SmoothOptions smoothing = pipeline_smoothing_defaults();
   /// Refuse before refining when n * 27^passes could exceed this many output hexes (int32 ids).
   int64_t max_hexes = std::numeric_limits<int32_t>::max();
   MeshWriteOptions write;  ///< how pipeline_run_files writes the output

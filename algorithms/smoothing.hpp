@@ -5,13 +5,17 @@
 ///
 /// Guarantees (for any input whose hexes all have a positive scaled Jacobian, and for the others
 /// as far as they go): the minimum scaled Jacobian never decreases, no hex with a positive scaled
-/// Jacobian becomes non-positive, boundary nodes stay on their planar patch (or stay put), the
-/// hexes, their connectivity and attributes are unchanged, and the result is deterministic.
+/// Jacobian becomes non-positive, boundary nodes stay on the boundary surface by construction
+/// (on the quads they started on, or with a reference on the input face they subdivide), the
+/// hexes, their connectivity and attributes are unchanged, only the region's nodes move, and the
+/// result is deterministic.
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <vector>
 
+#include "algorithms/node_placement.hpp"
 #include "mesh/hex_mesh.hpp"
 #include "mesh/topology.hpp"
 
@@ -25,57 +29,68 @@ enum class SmoothMethod {
               ///< minimum scaled Jacobian of the hexes around the node
 };
 
+/// How smoothing treats a boundary node, from the boundary faces around it.
+enum class SmoothNodeKind : int8_t {
+  interior,  ///< on no boundary face: moves freely
+  surface,   ///< on the boundary, no feature edge: slides on the boundary quads around it
+  curve,     ///< on exactly two feature edges: slides along them
+  corner,    ///< on one or three or more feature edges, or a degenerate or non-manifold face
+};
+
+/// Per-node classification (SmoothNodeKind), size node_count.
+struct SmoothNodeClasses {
+  std::vector<SmoothNodeKind> kind;
+};
+
+/// Classifies every node. A boundary edge is a feature edge when the unit normals (from the
+/// diagonals' cross product) of two boundary faces at it differ by more than
+/// `feature_angle_degrees`, or when it lies on other than two boundary faces. A zero-area boundary
+/// face makes its nodes corners. Precondition: `topology` was built from `mesh`.
+SmoothNodeClasses mesh_classify_smooth_nodes(const HexMesh& mesh, const HexTopology& topology,
+                                             double feature_angle_degrees);
+
 struct SmoothOptions {
   SmoothMethod method = SmoothMethod::optimize;
   int max_sweeps = 20;  ///< >= 0; 0 only measures
-  /// Boundary nodes whose boundary faces' normals differ by more than this (in (0, 180)) are
-  /// feature nodes (edges, corners) and stay fixed.
+  /// Boundary faces whose normals differ by more than this (in (0, 180)) meet at a feature edge.
   double feature_angle_degrees = 30;
   /// Empty: all hexes. Otherwise only the nodes of these hexes move (ids in [0, hex_count)).
   std::vector<int32_t> region_hexes;
+  /// >= 0: layers of hexes (sharing a node) around the region whose nodes move too.
+  int layers = 0;
+  /// Nodes are visited only while the worst hex around them is below this (in (0, 1]; default
+  /// 0.5, the lower end of Verdict's acceptable range): a region of acceptable hexes costs one
+  /// pass over its nodes, the work goes where quality is poor.
+  double visit_below = 0.5;
+  /// The input of a refinement (refine --smooth): boundary nodes the refinement made slide only
+  /// within the input face or edge they subdivide (the refined mesh keeps subdividing the input's
+  /// boundary faces, as the checker verifies against the input), the input's own boundary nodes
+  /// stay. `reference_nodes` is the input's node count, the mesh's parent_hex attribute names the
+  /// input hexes. nullptr: boundary nodes slide on the mesh's own boundary quads (SmoothNodeKind).
+  const BoundaryReference* reference = nullptr;
+  int32_t reference_nodes = 0;
 };
 
 struct SmoothStats {
   double min_scaled_jacobian_before = 1, min_scaled_jacobian_after = 1;
   /// Mean hex scaled Jacobian (1 for an empty mesh).
   double mean_scaled_jacobian_before = 1, mean_scaled_jacobian_after = 1;
-  double seconds = 0;       ///< smoothing only, no I/O
-  int sweeps = 0;           ///< sweeps carried out (<= max_sweeps)
-  int64_t nodes_moved = 0;  ///< nodes whose final position differs from the input
+  double seconds = 0;        ///< smoothing only, no I/O
+  int sweeps = 0;            ///< sweeps carried out (<= max_sweeps)
+  int64_t nodes_moved = 0;   ///< nodes whose final position differs from the input
+  int64_t region_hexes = 0;  ///< hexes of the region and its layers
+  int64_t movable_nodes = 0;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SmoothStats, min_scaled_jacobian_before,
                                                 min_scaled_jacobian_after,
                                                 mean_scaled_jacobian_before,
                                                 mean_scaled_jacobian_after, seconds, sweeps,
-                                                nodes_moved)
+                                                nodes_moved, region_hexes, movable_nodes)
 
-/// How smoothing treats a node (mesh_smooth classifies every node once, before the sweeps).
-enum class SmoothNodeKind : int8_t {
-  interior,  ///< on no boundary face: moves freely
-  planar,    ///< all boundary faces around it lie in one plane: slides in that plane
-  curved,    ///< boundary faces within the feature angle but not coplanar: fixed (no geometry)
-  feature,   ///< boundary face normals differ by more than the feature angle: fixed
-};
-
-/// Per-node classification and, for planar nodes, the unit normal of their plane.
-struct SmoothNodeClasses {
-  std::vector<SmoothNodeKind> kind;     ///< size node_count
-  std::vector<Eigen::Vector3d> normal;  ///< size node_count; zero unless kind is planar
-};
-
-/// Classifies every node from the boundary faces around it (outward unit normals from the
-/// diagonals' cross product). Planar: every incident boundary face normal is parallel to the first
-/// (to 1e-9) and every node of those faces lies within 1e-9 face diagonals of the node's plane.
-/// Feature: some pair of incident normals makes an angle above `feature_angle_degrees`; a zero-area
-/// boundary face makes its nodes features too. Precondition: `topology` was built from `mesh`.
-SmoothNodeClasses mesh_classify_smooth_nodes(const HexMesh& mesh, const HexTopology& topology,
-                                             double feature_angle_degrees);
-
-/// Smooths `mesh` in place. Sweeps visit the movable nodes worst-first (by the lowest scaled
-/// Jacobian of the hexes around each node, ties by node id) and stop after `max_sweeps` or when a
-/// sweep no longer changes the mesh noticeably. Throws InputError for bad options (negative
-/// sweeps, feature angle outside (0, 180), region hex id out of range) or a mesh failing
-/// mesh_validate_ids or holding a non-finite coordinate.
+/// Smooths `mesh` in place. Throws InputError for bad options (negative sweeps or layers, feature
+/// angle outside (0, 180), visit_below outside (0, 1], region hex id out of range) or a mesh
+/// failing mesh_validate_ids or holding a non-finite coordinate. The min and mean before and after
+/// are over the whole mesh.
 SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options);
 
 /// The default region of `refine --smooth`: the refined and transition hexes, i.e. those whose

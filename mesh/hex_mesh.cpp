@@ -68,4 +68,24 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box(const HexMesh& mes
   return {lo, hi};
 }
 
+SubMesh mesh_extract(const HexMesh& mesh, const std::vector<int32_t>& hexes) {
+  SubMesh sub;
+  std::vector<int32_t> local(mesh.points.size(), -1);
+  sub.mesh.hexes.reserve(hexes.size());
+  for (int32_t h : hexes) {
+    HexCell c = mesh.hexes[h];
+    for (int32_t& v : c) {
+      if (local[v] < 0) {
+        local[v] = static_cast<int32_t>(sub.node_of.size());
+        sub.node_of.push_back(v);
+      }
+      v = local[v];
+    }
+    sub.mesh.hexes.push_back(c);
+  }
+  sub.mesh.points.reserve(sub.node_of.size());
+  for (int32_t v : sub.node_of) sub.mesh.points.push_back(mesh.points[v]);
+  return sub;
+}
+
 }  // namespace hexrefine

@@ -57,6 +57,15 @@ Eigen::Vector3d hex_centroid(const HexMesh& mesh, int32_t h);
 /// The 8 corner positions of hex `h`.
 std::array<Eigen::Vector3d, 8> hex_points(const HexMesh& mesh, int32_t h);
 
+/// A part of a mesh as a mesh of its own: the hexes `hexes` (in that order) with their nodes
+/// numbered compactly in order of first use; node_of[i] is the node of the whole mesh that local
+/// node i is. No attributes. Precondition: mesh_validate_ids(mesh) holds, ids in range.
+struct SubMesh {
+  HexMesh mesh;
+  std::vector<int32_t> node_of;
+};
+SubMesh mesh_extract(const HexMesh& mesh, const std::vector<int32_t>& hexes);
+
 /// Axis-aligned bounding box of all points (min, max); zero box for an empty mesh.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box(const HexMesh& mesh);
 

@@ -124,6 +124,7 @@ TEST_P(SmoothingMethods, TiltedPlanarBoundaryStaysOnItsPlane) {
   const HexMesh input = m;
   SmoothOptions o;
   o.method = GetParam();
+  o.visit_below = 1;  // every node (its hexes are all above 0.5)
   const SmoothStats s = mesh_smooth(m, o);
   EXPECT_GT(s.min_scaled_jacobian_after, s.min_scaled_jacobian_before);
   ASSERT_EQ(bottom.size(), 16u);
@@ -275,7 +276,9 @@ TEST(Smoothing, CurvedBoundaryNodesSlideOnTheBoundarySurface) {
           {input.points[q[0]], input.points[q[1]], input.points[q[2]], input.points[q[3]]});
   }
   ASSERT_EQ(top.size(), 16u);
-  const SmoothStats s = mesh_smooth(m, {});
+  SmoothOptions o;
+  o.visit_below = 1;  // every node (its hexes are all above 0.5)
+  const SmoothStats s = mesh_smooth(m, o);
   EXPECT_GE(s.min_scaled_jacobian_after, s.min_scaled_jacobian_before);
   int slid = 0;
   for (int32_t n = 0; n < m.point_count(); ++n) {
@@ -357,9 +360,7 @@ TEST(Smoothing, StatsToJsonCarriesEveryField) {
 
 // The thesis' L-shaped case (targets: hexes on the x-min and z-min surfaces of a 10x10x10
 // brick) refined by the Selective Approach, then smoothed over the refined and transition hexes
-// (refine --smooth's default region). Measured: 8,060 hexes, 7,420 in the region; min scaled
-// Jacobian 0.3077 -> 0.3077 (laplacian: the worst hexes' nodes are boundary or stuck; mean
-// 0.8775 -> 0.9041) and 0.3077 -> 0.5031 (optimize; mean 0.8775 -> 0.9032).
+// (refine --smooth's default region), nodes visited while their worst hex is below 0.5.
 TEST_P(SmoothingMethods, LShapedSelectiveRefinementThenSmoothing) {
   const HexMesh brick = fixture_brick(10, 10, 10);
   Targets targets;
@@ -385,9 +386,12 @@ TEST_P(SmoothingMethods, LShapedSelectiveRefinementThenSmoothing) {
   EXPECT_LT(s.min_scaled_jacobian_before, 0.35);
   EXPECT_DOUBLE_EQ(s.min_scaled_jacobian_after, mesh_min_scaled_jacobian(m));
   EXPECT_GE(s.min_scaled_jacobian_after, s.min_scaled_jacobian_before);
-  EXPECT_GT(s.mean_scaled_jacobian_after, s.mean_scaled_jacobian_before + 0.02);
   if (GetParam() == SmoothMethod::optimize) {
+    // The max-min ascent trades a little of the mean for the worst hexes.
     EXPECT_GT(s.min_scaled_jacobian_after, 0.45);
+    EXPECT_GT(s.mean_scaled_jacobian_after, s.mean_scaled_jacobian_before - 0.01);
+  } else {
+    EXPECT_GT(s.mean_scaled_jacobian_after, s.mean_scaled_jacobian_before + 0.02);
   }
   for (int32_t n = 0; n < m.point_count(); ++n) {
     if (!allowed[n]) {

@@ -230,7 +230,7 @@ void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOpt
     case MeshFormat::gmsh:
       return io_detail::gmsh_write(path, mesh, options.cell_scalars);
     case MeshFormat::exodus:
-      return io_detail::exodus_write(path, mesh);
+      return io_detail::exodus_write(path, mesh, options.cell_scalars);
     case MeshFormat::abaqus:
       return io_detail::abaqus_write(path, mesh);
   }

@@ -27,10 +27,12 @@
 ///   are all integers becomes an attribute.
 /// - Exodus II: one element block per block_id (id 1 when the mesh has no block_id). Hexes keep
 ///   their order through the element id map (written as hex index + 1; when a file's element ids
-///   are a permutation of 1..n the reader orders hexes by id).
+///   are a permutation of 1..n the reader orders hexes by id). Every other attribute (parent_hex,
+///   template_tag, ...) and every cell scalar is an element variable at one time step; on
+///   reading, element variables whose values are all integers become attributes.
 /// - Abaqus: one `*ELSET, ELSET=BLOCK_<id>` per block_id; on reading, elsets named
 ///   `BLOCK_<integer>` (any case) give block_id, other hexes get 0.
-/// Other attributes are dropped by MEDIT, Exodus and Abaqus.
+/// Other attributes are dropped by MEDIT and Abaqus.
 ///
 /// Every reader calls mesh_validate_ids, refuses faces shared by more than two hexes, NaN or
 /// infinite coordinates, counts that the file is too small to hold (checked before allocating),

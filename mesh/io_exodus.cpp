@@ -13,7 +13,9 @@
 #include <netcdf.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -133,34 +135,69 @@ bool netcdf_classic_header_check(const std::string& path, std::string_view bytes
       skip_padded(values * size, "attribute values");
     }
   };
-  number(count_size, "record count");
+  const uint64_t records = number(count_size, "record count");
   // Dimensions.
   const uint64_t dim_tag = number(4, "dimension list tag");
   const uint64_t dims = count("dimension count", 8);
   if (!truncated && dim_tag != 0x0A && !(dim_tag == 0 && dims == 0)) fail("bad dimension list tag");
+  std::vector<uint64_t> dim_length;
   for (uint64_t i = 0; i < dims && !truncated; ++i) {
     name();
-    number(count_size, "dimension length");
+    dim_length.push_back(number(count_size, "dimension length"));
   }
   if (!truncated) attributes();
   // Variables.
   const uint64_t var_tag = number(4, "variable list tag");
   const uint64_t vars = count("variable count", 24);
   if (!truncated && var_tag != 0x0B && !(var_tag == 0 && vars == 0)) fail("bad variable list tag");
+  // Where each variable's data ends (record variables: in the first record).
+  struct Extent {
+    uint64_t begin, size;
+    bool record;
+  };
+  std::vector<Extent> extents;
   for (uint64_t i = 0; i < vars && !truncated; ++i) {
     name();
     const uint64_t rank = count("variable rank", count_size);
-    for (uint64_t k = 0; k < rank && !truncated; ++k)
-      if (number(count_size, "dimension id") >= dims && !truncated)
-        fail("dimension id out of range");
+    bool record = false;
+    for (uint64_t k = 0; k < rank && !truncated; ++k) {
+      const uint64_t id = number(count_size, "dimension id");
+      if (truncated) break;
+      if (id >= dims) fail("dimension id out of range");
+      if (k == 0 && dim_length[id] == 0) record = true;  // the unlimited dimension
+    }
     if (truncated) break;
     attributes();
     if (truncated) break;
     type_size(number(4, "variable type"));
-    number(count_size, "variable size");
-    number(version == 1 ? 4 : 8, "variable offset");
+    const uint64_t size = number(count_size, "variable size");
+    const uint64_t begin = number(version == 1 ? 4 : 8, "variable offset");
+    extents.push_back({begin, size, record});
   }
-  return !truncated;
+  if (truncated) return false;
+  // Every variable's data inside the file: a truncated file is refused here, not read as the
+  // netCDF library's zeros or fill values. Record variables repeat every record size bytes.
+  uint64_t record_size = 0;
+  for (const Extent& e : extents)
+    if (e.record) record_size += e.size;
+  const bool streaming = count_size == 4 && records == 0xFFFFFFFFu;
+  for (const Extent& e : extents) {
+    if (e.size > static_cast<uint64_t>(file_size))
+      throw InputError(path + ": netCDF variable of " + std::to_string(e.size) +
+                       " bytes larger than the file (" + std::to_string(file_size) + " bytes)");
+    uint64_t end = e.begin + e.size;
+    if (e.record) {
+      if (streaming || records == 0) continue;
+      if (record_size > 0 && records - 1 > static_cast<uint64_t>(file_size) / record_size)
+        throw InputError(path + ": netCDF record count " + std::to_string(records) +
+                         " larger than the file can hold: truncated file");
+      end += (records - 1) * record_size;
+    }
+    if (e.begin > static_cast<uint64_t>(file_size) || end > static_cast<uint64_t>(file_size))
+      throw InputError(path + ": netCDF variable data runs past the end of the file (" +
+                       std::to_string(file_size) + " bytes): truncated file");
+  }
+  return true;
 }
 
 /// Closes a netCDF id on every path out.
@@ -268,6 +305,95 @@ void exodus_netcdf_check(const std::string& path) {
 
 }  // namespace
 
+/// The element variables of the hex blocks whose values are all integers (in the int32 range) at
+/// the first time step, as attributes in the reader's hex order (blocks in file order), read
+/// through netCDF with every shape checked (name_elem_var: num_elem_var x len_name; vals_elem_var
+/// VebB: time_step x num_el_in_blkB) rather than through libexodusii (see exodus_netcdf_check).
+/// A variable missing from a hex block, or with a non-integral value, is skipped; block_id is
+/// skipped (it comes from the blocks).
+std::vector<HexAttribute> exodus_element_variables(
+    const std::string& path, const std::vector<std::pair<int64_t, int64_t>>& hex_blocks) {
+  std::vector<HexAttribute> out;
+  NetcdfFile file;
+  if (nc_open(path.c_str(), NC_NOWRITE, &file.id) != NC_NOERR) {
+    file.id = -1;
+    return out;
+  }
+  auto dimension = [&](const std::string& name) -> int64_t {
+    int id = -1;
+    size_t length = 0;
+    if (nc_inq_dimid(file.id, name.c_str(), &id) != NC_NOERR ||
+        nc_inq_dimlen(file.id, id, &length) != NC_NOERR)
+      return -1;
+    return static_cast<int64_t>(length);
+  };
+  // The variable `name` of rank 2 over exactly (d0, d1), its id or -1.
+  auto variable = [&](const std::string& name, const std::string& d0, const std::string& d1) {
+    int id = -1, rank = 0, dims[NC_MAX_VAR_DIMS] = {0};
+    char dim_name[NC_MAX_NAME + 1] = {0};
+    if (nc_inq_varid(file.id, name.c_str(), &id) != NC_NOERR ||
+        nc_inq_varndims(file.id, id, &rank) != NC_NOERR || rank != 2 ||
+        nc_inq_vardimid(file.id, id, dims) != NC_NOERR)
+      return -1;
+    for (int d = 0; d < 2; ++d)
+      if (nc_inq_dimname(file.id, dims[d], dim_name) != NC_NOERR || dim_name != (d ? d1 : d0))
+        return -1;
+    return id;
+  };
+  const int64_t count = dimension("num_elem_var"), name_length = dimension("len_name");
+  if (count <= 0 || count > 1000 || name_length <= 0 || name_length > 4096 ||
+      dimension("time_step") < 1)
+    return out;
+  const int names_id = variable("name_elem_var", "num_elem_var", "len_name");
+  if (names_id < 0) return out;
+  std::vector<char> names(static_cast<size_t>(count * name_length) + 1, 0);
+  nc_type names_type = NC_NAT;
+  if (nc_inq_vartype(file.id, names_id, &names_type) != NC_NOERR || names_type != NC_CHAR)
+    return out;
+  if (nc_get_var_text(file.id, names_id, names.data()) != NC_NOERR)
+    throw InputError(path + ": cannot read the element variable names: corrupt or truncated file");
+  int64_t total = 0;
+  for (const auto& [b, n] : hex_blocks) total += n;
+  for (int64_t v = 0; v < count; ++v) {
+    const char* begin = names.data() + v * name_length;
+    std::string name(begin, strnlen(begin, static_cast<size_t>(name_length)));
+    while (!name.empty() && name.back() == ' ') name.pop_back();
+    if (name.empty() || name == attribute_block_id) continue;
+    HexAttribute a{name, {}};
+    a.values.reserve(total);
+    bool ok = true;
+    std::vector<double> values;
+    for (const auto& [b, n] : hex_blocks) {
+      const std::string k = std::to_string(b + 1);
+      const int id = variable("vals_elem_var" + std::to_string(v + 1) + "eb" + k, "time_step",
+                              "num_el_in_blk" + k);
+      if (id < 0 || dimension("num_el_in_blk" + k) != n) {
+        ok = false;
+        break;
+      }
+      values.assign(static_cast<size_t>(n), 0.0);
+      const size_t start[2] = {0, 0}, extent[2] = {1, static_cast<size_t>(n)};
+      if (n > 0 && nc_get_vara_double(file.id, id, start, extent, values.data()) != NC_NOERR)
+        throw InputError(path + ": cannot read element variable '" + name + "' of block " + k +
+                         ": corrupt or truncated file");
+      for (double x : values) {
+        // netCDF returns its fill value for data missing from a truncated file.
+        if (x == 9.9692099683868690e+36)
+          throw InputError(path + ": element variable '" + name + "' of block " + k +
+                           " has an unwritten (netCDF fill) value: corrupt or truncated file");
+        if (!(x == std::floor(x) && x >= INT32_MIN && x <= INT32_MAX)) {
+          ok = false;
+          break;
+        }
+        a.values.push_back(static_cast<int32_t>(x));
+      }
+      if (!ok) break;
+    }
+    if (ok) out.push_back(std::move(a));
+  }
+  return out;
+}
+
 HexMesh exodus_read(const std::string& path) {
   // Check the netCDF signature ourselves first: the library must only ever see files that at
   // least claim to be netCDF, and the size bounds the counts below.
@@ -350,6 +476,7 @@ HexMesh exodus_read(const std::string& path) {
                        "(corrupt or truncated file)");
   std::vector<int64_t> hex_ids;
   std::vector<int32_t> block;
+  std::vector<std::pair<int64_t, int64_t>> hex_blocks;  // (file-order block index, hex count)
   int64_t first_element = 0;
   for (int64_t b = 0; b < blocks; ++b) {
     const int64_t bid = block_ids[b];
@@ -400,6 +527,7 @@ HexMesh exodus_read(const std::string& path) {
         block.push_back(static_cast<int32_t>(block_id));
         hex_ids.push_back(element_map[first_element + e]);
       }
+      hex_blocks.push_back({b, count});
     }
     first_element += count;
   }
@@ -415,20 +543,24 @@ HexMesh exodus_read(const std::string& path) {
     else
       seen[t - 1] = 1, slot[i] = static_cast<int32_t>(t - 1);
   }
+  mesh.attributes.push_back({std::string(attribute_block_id), std::move(block)});
+  for (HexAttribute& a : exodus_element_variables(path, hex_blocks)) mesh.attributes.push_back(a);
   if (permutation) {
     std::vector<HexCell> hexes(m);
-    std::vector<int32_t> blocks_ordered(m);
-    for (size_t i = 0; i < m; ++i)
-      hexes[slot[i]] = mesh.hexes[i], blocks_ordered[slot[i]] = block[i];
+    for (size_t i = 0; i < m; ++i) hexes[slot[i]] = mesh.hexes[i];
     mesh.hexes = std::move(hexes);
-    block = std::move(blocks_ordered);
+    for (HexAttribute& a : mesh.attributes) {
+      std::vector<int32_t> ordered(m);
+      for (size_t i = 0; i < m; ++i) ordered[slot[i]] = a.values[i];
+      a.values = std::move(ordered);
+    }
   }
-  mesh.attributes.push_back({std::string(attribute_block_id), std::move(block)});
   mesh_check_read(mesh, path);
   return mesh;
 }
 
-void exodus_write(const std::string& path, const HexMesh& mesh) {
+void exodus_write(const std::string& path, const HexMesh& mesh,
+                  const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars) {
   const std::vector<int32_t>* block = mesh_find_attribute(mesh, attribute_block_id);
   const size_t m = mesh.hexes.size(), n = mesh.points.size();
   std::vector<std::pair<int32_t, int32_t>> order(m);
@@ -485,6 +617,41 @@ void exodus_write(const std::string& path, const HexMesh& mesh) {
       }
     }
     if (m > 0 && ex_put_id_map(file.id, EX_ELEM_MAP, map.data()) < 0) failed("element id map");
+    // Element variables (one time step): every attribute but block_id (the blocks hold it),
+    // then the cell scalars, by block in the order written above.
+    std::vector<std::pair<std::string, std::vector<double>>> fields;
+    for (const HexAttribute& a : mesh.attributes)
+      if (a.name != attribute_block_id)
+        fields.push_back({a.name, std::vector<double>(a.values.begin(), a.values.end())});
+    for (const auto& s : cell_scalars) fields.push_back(s);
+    if (m > 0 && !fields.empty()) {
+      size_t longest = 0;
+      for (const auto& f : fields) longest = std::max(longest, f.first.size());
+      if (longest > 32 && ex_set_max_name_length(file.id, static_cast<int>(longest)) < 0)
+        failed("variable name length");
+      if (ex_put_variable_param(file.id, EX_ELEM_BLOCK, static_cast<int>(fields.size())) < 0)
+        failed("element variable count");
+      std::vector<char*> names;
+      for (auto& f : fields) names.push_back(f.first.data());
+      if (ex_put_variable_names(file.id, EX_ELEM_BLOCK, static_cast<int>(fields.size()),
+                                names.data()) < 0)
+        failed("element variable names");
+      const double time = 0.0;
+      if (ex_put_time(file.id, 1, &time) < 0) failed("time step");
+      std::vector<double> values;
+      size_t at = 0;
+      for (size_t bi = 0; bi < blocks.size(); ++bi) {
+        const size_t first = at;
+        while (at < m && order[at].first == blocks[bi]) ++at;
+        for (size_t f = 0; f < fields.size(); ++f) {
+          values.clear();
+          for (size_t k = first; k < at; ++k) values.push_back(fields[f].second[order[k].second]);
+          if (ex_put_var(file.id, 1, EX_ELEM_BLOCK, static_cast<int>(f + 1), exodus_ids[bi],
+                         static_cast<int64_t>(values.size()), values.data()) < 0)
+            failed("element variable " + fields[f].first);
+        }
+      }
+    }
     const int id = file.id;
     file.id = -1;
     if (ex_close(id) < 0) failed("close (disk full?)");

@@ -310,7 +310,8 @@ HexMesh gmsh_read(const std::string& path, const std::string& text);
 void gmsh_write(const std::string& path, const HexMesh& mesh,
                 const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
 HexMesh exodus_read(const std::string& path);
-void exodus_write(const std::string& path, const HexMesh& mesh);
+void exodus_write(const std::string& path, const HexMesh& mesh,
+                  const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
 HexMesh abaqus_read(const std::string& path, const std::string& text);
 void abaqus_write(const std::string& path, const HexMesh& mesh);
 

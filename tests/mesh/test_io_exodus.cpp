@@ -16,7 +16,24 @@ TEST(IoExodus, RoundTripIsExactAndKeepsBlocksAndOrder) {
   const HexMesh r = mesh_read(path);
   io_expect_same_geometry(m, r, 0);
   io_expect_same_attribute(m, r, attribute_block_id);
-  EXPECT_EQ(mesh_find_attribute(r, attribute_template_tag), nullptr);
+  // Every other attribute travels as an element variable (parent_hex, so that fields map from
+  // parents to children): exactly, in hex order.
+  for (const HexAttribute& a : m.attributes) io_expect_same_attribute(m, r, a.name);
+  EXPECT_EQ(r.attributes.size(), m.attributes.size());
+}
+
+TEST(IoExodus, ParentHexIsAnElementVariableAndFloatFieldsAreNotAttributes) {
+  const auto dir = test_temp_dir("io_exodus_variables");
+  HexMesh m = io_test_brick();
+  std::vector<int32_t>& parent = mesh_attribute(m, attribute_parent_hex);
+  for (int32_t h = 0; h < m.hex_count(); ++h) parent[h] = 1000 - 3 * h;
+  MeshWriteOptions o;
+  o.cell_scalars.push_back({"scaled_jacobian", std::vector<double>(m.hexes.size(), 0.25)});
+  const std::string path = (dir / "v.e").string();
+  mesh_write(path, m, o);
+  const HexMesh r = mesh_read(path);
+  io_expect_same_attribute(m, r, attribute_parent_hex);
+  EXPECT_EQ(mesh_find_attribute(r, "scaled_jacobian"), nullptr);  // not integral: a field
 }
 
 TEST(IoExodus, NonPositiveBlockIdsSurviveThroughBlockNames) {

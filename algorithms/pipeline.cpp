@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "mesh/error.hpp"
+#include "mesh/quality.hpp"
 #include "mesh/selection.hpp"
 
 namespace hexrefine {
@@ -137,6 +138,24 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
     r.stats = std::move(refined.stats);
   }
   clock.end("refine");
+  {
+    // A refined parent's children are a level above it (the input's own levels, if any, kept).
+    const std::vector<int32_t>* parent = mesh_find_attribute(r.mesh, attribute_parent_hex);
+    const std::vector<int32_t>* level = mesh_find_attribute(r.mesh, attribute_refinement_level);
+    const std::vector<int32_t>* input_level =
+        mesh_find_attribute(input, attribute_refinement_level);
+    std::vector<uint8_t> refined(input.hexes.size(), 0);
+    for (int32_t h = 0; parent && level && h < r.mesh.hex_count(); ++h) {
+      const int32_t p = (*parent)[h];
+      if ((*level)[h] > (input_level ? (*input_level)[p] : 0)) refined[p] = 1;
+    }
+    for (int32_t h = 0; h < input.hex_count(); ++h)
+      if (refined[h]) {
+        ++r.refined_parents;
+        r.refined_parents_min_scaled_jacobian = std::min(r.refined_parents_min_scaled_jacobian,
+                                                         hex_scaled_jacobian(hex_points(input, h)));
+      }
+  }
 
   r.check = mesh_check(r.mesh, &input);
   clock.end("check");
@@ -201,6 +220,8 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
   if (!r.selection_warning.empty()) selection["warning"] = r.selection_warning;
   j["selection"] = selection;
   j["refine"] = r.stats;
+  j["refined_parents"] = {{"hexes", r.refined_parents},
+                          {"min_scaled_jacobian", r.refined_parents_min_scaled_jacobian}};
   j["check"] = r.check;
   if (r.smoothing) j["smoothing"] = {{"stats", *r.smoothing}, {"check", *r.smoothed_check}};
   j["stage_seconds"] = r.stage_seconds;

@@ -63,7 +63,12 @@ struct PipelineResult {
   RefineStats stats;
   std::vector<int32_t> selected;  ///< the targets, ascending
   std::string selection_warning;  ///< non-empty when the selection matched nothing
-  MeshCheckReport check;          ///< the refined mesh against the input
+  /// Input hexes that were refined (their children's refinement level is above theirs) and their
+  /// lowest scaled Jacobian (1 if none): what a refinement's quality is fairly
+  /// compared with.
+  int64_t refined_parents = 0;
+  double refined_parents_min_scaled_jacobian = 1;
+  MeshCheckReport check;  ///< the refined mesh against the input
   std::optional<SmoothStats> smoothing;
   std::optional<MeshCheckReport> smoothed_check;  ///< the smoothed mesh against the input
   /// Seconds per stage: read, select, refine, check, smooth, check_smoothed, write, total
@@ -86,8 +91,9 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
                                   const PipelineOptions& options);
 
 /// The report: "method", "options" (RefineOptions plus "smooth"), "selection" ({"specs",
-/// "hexes", "warning"?}), "refine" (RefineStats), "check", "smoothing"? ({"stats", "check"}),
-/// "stage_seconds", "peak_memory_mb". The CLI writes it with --report, the runner adds its
+/// "hexes", "warning"?}), "refine" (RefineStats), "refined_parents" ({"hexes",
+/// "min_scaled_jacobian"}), "check", "smoothing"? ({"stats", "check"}), "stage_seconds",
+/// "peak_memory_mb". The CLI writes it with --report, the runner adds its
 /// identification fields to it, the Python module returns it as a dict.
 nlohmann::json pipeline_report(const PipelineResult& result, const PipelineOptions& options);
 

@@ -1,6 +1,11 @@
 #include "experiments/cases.hpp"
 
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstdio>
 #include <vector>
+
+#include "mesh/io.hpp"
 
 namespace hexrefine {
 
@@ -17,7 +22,23 @@ json make_case(const std::string& name, json mesh, std::vector<std::string> sele
               {"mesh", std::move(mesh)},
               {"select", std::move(select)},
               {"methods", {"selective", "sheet"}},
+              {"options", {{"placement", "trilinear"}}},
               {"tags", std::move(tags)}};
+}
+
+/// The same case with optimized placement: the extra column of the single-case tables.
+json optimized_variant(json c) {
+  c["name"] = c["name"].get<std::string>() + "/optimized";
+  c["options"]["placement"] = "optimized";
+  c["tags"]["placement"] = "optimized";
+  c.erase("save_mesh");
+  return c;
+}
+
+std::string number_text(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
 }
 
 }  // namespace
@@ -59,7 +80,7 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
     json c = make_case(buffer ? "H-2" : "H-2/no-buffer", brick(4, 4, 4), {"boundary:-1,0,0"},
                        {{"table", "H-2"}, {"buffer", buffer}});
     c["passes"] = 3;
-    c["options"] = {{"buffer", buffer}};
+    c["options"]["buffer"] = buffer;
     cases.push_back(c);
   }
   cases.push_back(make_case("H-3",
@@ -69,6 +90,11 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
                             {{"table", "H-4"}}));
   cases.push_back(make_case("real/ellipsoid-sphere", json{{"file", meshes_dir + "/ellipsoid.mesh"}},
                             {"sphere:0,0,0,0.15"}, {{"table", "real"}}));
+
+  // Every single-case table again with optimized node placement (the thesis' numbers above are
+  // the trilinear placement's).
+  const size_t single = cases.size();
+  for (size_t i = 0; i < single; ++i) cases.push_back(optimized_variant(cases[i]));
 
   // Ablations of the Selective Approach on the L-shaped and the radial case.
   const json variants = {{"no-ranking", {{"ranking", false}}},
@@ -82,7 +108,7 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
       json c = make_case("ablation/" + base + "/" + variant, mesh, select,
                          {{"table", "ablation"}, {"base", base}, {"variant", variant}});
       c["methods"] = {"selective"};
-      c["options"] = options;
+      c["options"].update(options);
       cases.push_back(c);
     }
   }
@@ -100,6 +126,60 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
 
   return json{{"description", std::string("Parrish's thesis suite (hexrefine reproduce") +
                                   (quick ? " --quick" : "") + "); see results/README.md"},
+              {"cases", cases},
+              {"output", output}};
+}
+
+json real_mesh_study_cases(const std::vector<std::string>& mesh_files,
+                           const std::string& meshes_read_dir, const std::string& meshes_dir,
+                           const std::string& output) {
+  json cases = json::array();
+  for (const std::string& file : mesh_files) {
+    const HexMesh m = mesh_read(meshes_read_dir + "/" + file);
+    const auto [lo, hi] = mesh_bounding_box(m);
+    const Eigen::Vector3d centre = (lo + hi) / 2;
+    const double diagonal = (hi - lo).norm();
+    auto sphere = [&](double fraction) {
+      return "sphere:" + number_text(centre.x()) + "," + number_text(centre.y()) + "," +
+             number_text(centre.z()) + "," + number_text(fraction * diagonal);
+    };
+    const std::string blob_count = std::to_string(std::max<int32_t>(20, m.hex_count() / 50));
+    struct Kind {
+      std::string name;
+      std::vector<std::string> select;
+      int passes;
+    };
+    std::vector<Kind> kinds = {
+        {"sphere", {sphere(0.15)}, 1},
+        {"blob-1", {"blob:" + blob_count + ",1"}, 1},
+        {"blob-2", {"blob:" + blob_count + ",2"}, 1},
+        {"surface", {"surface:0"}, 1},
+        {"scattered-1", {"random:0.02,1"}, 1},
+        {"scattered-2", {"random:0.02,2"}, 1},
+        {"two-passes", {sphere(0.1)}, 2},
+    };
+    // The case of the real-mesh issue: a ball at the rocker arm's origin.
+    if (file == "rockerarm.mesh") kinds.push_back({"issue-sphere", {"sphere:0,0,0,5"}, 1});
+    for (const Kind& kind : kinds)
+      for (const char* placement : {"trilinear", "optimized"}) {
+        json c = make_case(file + "/" + kind.name + "/" + placement,
+                           json{{"file", meshes_dir + "/" + file}}, kind.select,
+                           {{"study", "real_meshes"},
+                            {"mesh", file},
+                            {"kind", kind.name},
+                            {"placement", placement}});
+        c["smooth"] = true;
+        c["options"] = {{"placement", placement}};
+        if (kind.passes > 1) {
+          c["passes"] = kind.passes;
+          c["options"]["buffer"] = true;
+        }
+        cases.push_back(c);
+      }
+  }
+  return json{{"description",
+               "Real-mesh study (hexrefine study): every shared real mesh x region kind x both "
+               "methods x trilinear/optimized placement, smoothed; see results/real_meshes.md"},
               {"cases", cases},
               {"output", output}};
 }

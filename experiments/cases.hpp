@@ -24,6 +24,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace hexrefine {
 
@@ -32,6 +33,17 @@ namespace hexrefine {
 /// stops the G-2 and G-3 sweeps at n = 30.
 nlohmann::json thesis_suite_cases(bool quick, const std::string& meshes_dir,
                                   const std::string& output);
+
+/// The real-mesh study (`hexrefine study`): for each of `mesh_files` (names in `meshes_read_dir`,
+/// read here for their bounding boxes; `meshes_dir` is that folder as the case file sees it), the
+/// region kinds sphere (a ball about the bounding box's centre, radius 0.15 of its diagonal), grown
+/// blob (2 % of the hexes, at least 20, two seeds), boundary surface (the largest patch at 30
+/// degrees), scattered hexes (2 %, two seeds) and two passes with the buffer (a ball of 0.1 of the
+/// diagonal), plus rockerarm.mesh's sphere:0,0,0,5; both methods, trilinear and optimized
+/// placement, smoothed (the record keeps the unsmoothed check too).
+nlohmann::json real_mesh_study_cases(const std::vector<std::string>& mesh_files,
+                                     const std::string& meshes_read_dir,
+                                     const std::string& meshes_dir, const std::string& output);
 
 /// Sweep intervals: 5, 10, ..., 75 (quick: ..., 30).
 std::vector<int> thesis_sweep_intervals(bool quick);

@@ -81,6 +81,7 @@ extern const CliCommand cli_refine_command;
 extern const CliCommand cli_smooth_command;
 extern const CliCommand cli_run_command;
 extern const CliCommand cli_reproduce_command;
+extern const CliCommand cli_study_command;
 extern const CliCommand cli_merge_command;
 extern const CliCommand cli_bench_command;
 extern const CliCommand cli_bench_compare_command;

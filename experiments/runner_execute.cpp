@@ -65,6 +65,10 @@ void case_execute(const RunCase& c, const std::vector<std::string>& methods, con
     } catch (const OperationError& e) {
       emit(method, json{{"input", input}, {"error", e.what()}, {"error_kind", "operation"}});
       continue;
+    } catch (const InputError& e) {
+      // This method's answer to a bad input (an inverted hex, an invalid mesh, a bad spec).
+      emit(method, json{{"input", input}, {"error", e.what()}, {"error_kind", "input"}});
+      continue;
     }
     json fields = pipeline_report(r, o);
     fields.erase("options");  // the runner stamps the case's canonical options (record key)

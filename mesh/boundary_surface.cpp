@@ -46,7 +46,7 @@ BoundarySurface boundary_surface_build(const HexMesh& mesh, const HexTopology& t
   for (int32_t f = 0; f < t.face_count(); ++f) {
     if (!face_is_boundary(t, f)) continue;
     const int32_t h = t.face_hexes[f][0];
-    const int lf = t.face_local[f][0];
+    const int lf = hex_local_face(t, h, f);  // faces-only topologies have no face_local
     for (int i = 0; i < 4; ++i) {
       const int32_t node = mesh.hexes[h][hex_faces[lf][i]];
       if (node_vertex[node] < 0) node_vertex[node] = add_vertex(node).idx();

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <numbers>
+#include <random>
 #include <sstream>
 
 #include "mesh/boundary_surface.hpp"
@@ -101,8 +102,9 @@ Selection select_hexes(const HexMesh& mesh, const HexTopology& t,
       continue;
     }
     if (colon == std::string::npos)
-      throw InputError(spec_error(
-          spec, "expected all, hexes:FILE, box:..., sphere:..., boundary:... or block:..."));
+      throw InputError(spec_error(spec,
+                                  "expected all, hexes:FILE, box:..., sphere:..., boundary:..., "
+                                  "block:..., random:..., blob:... or surface:..."));
     if (kind == "hexes") {
       select_from_file(rest, nh, spec, selected);
     } else if (kind == "box") {
@@ -153,10 +155,63 @@ Selection select_hexes(const HexMesh& mesh, const HexTopology& t,
       for (int32_t h = 0; h < nh; ++h)
         for (long long id : ids)
           if ((*block)[h] == id) selected[h] = 1;
+    } else if (kind == "random") {
+      const std::vector<double> v = parse_numbers(rest, spec, {2});
+      if (!(v[0] > 0 && v[0] <= 1))
+        throw InputError(spec_error(spec, "fraction must be in (0, 1]"));
+      if (v[1] < 0 || v[1] != std::floor(v[1]) || v[1] > 9.007199254740992e15)
+        throw InputError(spec_error(spec, "seed must be an integer >= 0"));
+      std::mt19937_64 rng(static_cast<uint64_t>(v[1]));
+      for (int32_t h = 0; h < nh; ++h)
+        if (static_cast<double>(rng() >> 11) * 0x1.0p-53 < v[0]) selected[h] = 1;
+    } else if (kind == "blob") {
+      const std::vector<double> v = parse_numbers(rest, spec, {2});
+      if (v[0] < 1 || v[0] != std::floor(v[0]))
+        throw InputError(spec_error(spec, "count must be an integer >= 1"));
+      if (v[1] < 0 || v[1] != std::floor(v[1]) || v[1] > 9.007199254740992e15)
+        throw InputError(spec_error(spec, "seed must be an integer >= 0"));
+      if (nh == 0) continue;
+      std::mt19937_64 rng(static_cast<uint64_t>(v[1]));
+      const int32_t start = static_cast<int32_t>(rng() % static_cast<uint64_t>(nh));
+      const int64_t wanted = std::min<int64_t>(static_cast<int64_t>(v[0]), nh);
+      std::vector<char> in(nh, 0);
+      std::vector<int32_t> queue = {start};
+      in[start] = 1;
+      for (size_t i = 0; i < queue.size() && static_cast<int64_t>(i) < wanted; ++i) {
+        selected[queue[i]] = 1;
+        for (int lf = 0; lf < 6; ++lf) {
+          const int32_t n = hex_face_neighbor(t, queue[i], lf);
+          if (n >= 0 && !in[n]) {
+            in[n] = 1;
+            queue.push_back(n);
+          }
+        }
+      }
+    } else if (kind == "surface") {
+      const std::vector<double> v = parse_numbers(rest, spec, {1, 2});
+      if (v[0] < 0 || v[0] != std::floor(v[0]))
+        throw InputError(spec_error(spec, "patch rank must be an integer >= 0"));
+      const double degrees = v.size() == 2 ? v[1] : 30.0;
+      if (!(degrees > 0 && degrees <= 180))
+        throw InputError(spec_error(spec, "feature angle must be in (0, 180] degrees"));
+      const BoundarySurface surface = boundary_surface_build(mesh, t);
+      const SurfacePatches patches = boundary_surface_patches(surface, degrees);
+      // Patches by decreasing face count, ties by patch id: rank 0 is the largest.
+      std::vector<int32_t> order(patches.patch_count());
+      for (int32_t p = 0; p < patches.patch_count(); ++p) order[p] = p;
+      std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) {
+        return patches.patch_face_counts[a] > patches.patch_face_counts[b];
+      });
+      const size_t rank = static_cast<size_t>(v[0]);
+      if (rank >= order.size())
+        throw InputError(spec_error(spec, "the boundary has " + std::to_string(order.size()) +
+                                              " surfaces at that feature angle"));
+      for (int32_t f = 0; f < surface.face_count(); ++f)
+        if (patches.face_patch[f] == order[rank]) selected[surface.face_hex[f]] = 1;
     } else {
       throw InputError(spec_error(spec, "unknown selection '" + kind +
-                                            "' (expected all, hexes, box, sphere, boundary or "
-                                            "block)"));
+                                            "' (expected all, hexes, box, sphere, boundary, "
+                                            "block, random, blob or surface)"));
     }
   }
 
@@ -174,7 +229,9 @@ Selection select_hexes(const HexMesh& mesh, const HexTopology& t,
 
 Selection select_hexes(const HexMesh& mesh, const std::vector<std::string>& specs) {
   bool faces = false;
-  for (const std::string& spec : specs) faces = faces || spec.rfind("boundary:", 0) == 0;
+  for (const std::string& spec : specs)
+    for (const char* kind : {"boundary:", "blob:", "surface:"})
+      faces = faces || spec.rfind(kind, 0) == 0;
   return select_hexes(mesh, faces ? topology_build(mesh, TopologyParts::faces) : HexTopology{},
                       specs);
 }

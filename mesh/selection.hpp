@@ -13,7 +13,16 @@
 /// - `boundary:nx,ny,nz[,deg]`      hexes with a boundary face whose outward unit normal is within
 ///                                  deg (default 30, in [0, 180]) of the direction (nx, ny, nz)
 ///                                  (non-zero): `boundary:-1,0,0` is the left surface;
-/// - `block:ID[,ID...]`             hexes whose `block_id` attribute is one of the ids.
+/// - `block:ID[,ID...]`             hexes whose `block_id` attribute is one of the ids;
+/// - `random:FRACTION,SEED`          scattered hexes: each with probability FRACTION in (0, 1],
+///                                  drawn in hex order from std::mt19937_64(SEED) (uniform from the
+///                                  top 53 bits: the same set on every platform);
+/// - `blob:COUNT,SEED`              a grown blob: from a hex drawn by std::mt19937_64(SEED)
+///                                  (raw % hex count), the first COUNT hexes of a breadth-first
+///                                  walk across faces (neighbours in local face order);
+/// - `surface:RANK[,DEG]`           the hexes on one surface of the boundary: the boundary's
+///                                  patches at feature angle DEG (default 30; boundary_surface.hpp)
+///                                  by decreasing face count, RANK 0 the largest.
 
 #include <cstdint>
 #include <string>
@@ -37,7 +46,8 @@ struct Selection {
 Selection select_hexes(const HexMesh& mesh, const HexTopology& topology,
                        const std::vector<std::string>& specs);
 
-/// As above; the faces are built (TopologyParts::faces) only when a `boundary:` spec needs them.
+/// As above; the faces are built (TopologyParts::faces) only when a `boundary:`, `blob:` or
+/// `surface:` spec needs them.
 Selection select_hexes(const HexMesh& mesh, const std::vector<std::string>& specs);
 
 }  // namespace hexrefine

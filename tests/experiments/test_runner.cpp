@@ -429,10 +429,15 @@ TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
     const json root = thesis_suite_cases(quick, meshes, "thesis.jsonl");
     const RunPlan plan = run_plan_parse(root, "suite.json", "/");
     const size_t sweep = quick ? 6 : 15;  // n = 5..30 or 5..75
-    // G-1, 6-1, 6-2, H-1, ring, H-2 (two), H-3, H-4, real, 6 ablations, two sweeps.
-    EXPECT_EQ(plan.cases.size(), 16u + 2 * sweep);
-    int g2 = 0, ablations = 0;
+    // G-1, 6-1, 6-2, H-1, ring, H-2 (two), H-3, H-4, real (trilinear placement: the thesis'),
+    // the same ten with optimized placement, 6 ablations, two sweeps.
+    EXPECT_EQ(plan.cases.size(), 26u + 2 * sweep);
+    int g2 = 0, ablations = 0, optimized = 0;
     for (const RunCase& c : plan.cases) {
+      if (c.options.placement.method == PlacementMethod::optimized) {
+        ++optimized;
+        EXPECT_EQ(c.tags.value("placement", ""), "optimized") << c.name;
+      }
       if (c.tags.value("table", "") == "G-2") {
         ++g2;
         EXPECT_EQ(c.select, std::vector<std::string>{"all"});
@@ -446,6 +451,7 @@ TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
     }
     EXPECT_EQ(g2, static_cast<int>(sweep));
     EXPECT_EQ(ablations, 6);
+    EXPECT_EQ(optimized, 10);
     EXPECT_EQ(plan.cases[0].name, "G-1");
     EXPECT_TRUE(plan.cases[0].save_mesh);
     EXPECT_EQ(plan.cases[1].name, "6-1");

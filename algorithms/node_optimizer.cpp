@@ -461,19 +461,20 @@ class Optimizer {
     return value;
   }
 
+  /// Ascent on node i: the KS soft minimum's gradient projected on the slide, a step searched
+  /// from 5 % of the local edge length. The max-min phase keeps a step when the worst hex around
+  /// the node improves; the smooth phase when the soft minimum (low beta) rises and keep_positive
+  /// allows it.
   void ascent(int32_t i) {
-    if (soft_phase_) {
-      soft_ascent(i);
-      return;
-    }
-    double current = local_min(i);
-    if (current >= 1.0 - 1e-12) return;
+    double current = soft_phase_ ? 0.0 : local_min(i);
+    if (!soft_phase_ && current >= 1.0 - 1e-12) return;
     const double h = scale(i);
     if (!(h > 0)) return;
     double step = 0.05 * h;
     for (int iteration = 0; iteration < options_.ascent_steps; ++iteration) {
       Vec3 gradient;
-      soft_min(i, gradient);
+      const double soft = soft_min(i, gradient);
+      if (soft_phase_) current = soft;
       const Vec3 direction = slide_tangent(i, gradient);
       if (!(direction.norm() > 1e-12 / h)) return;
       const Vec3 unit = direction.normalized();
@@ -484,38 +485,12 @@ class Optimizer {
         const Vec3 candidate = slide_project(i, x + step * unit, s);
         if (candidate == x) continue;
         double m;
-        if (trial_min(i, candidate, m, nullptr, current + 1e-12)) {
-          commit(i, candidate, s);
-          current = m;
-          moved = true;
-          step = std::min(2 * step, 0.25 * h);
-          break;
-        }
-      }
-      if (!moved) return;
-    }
-  }
-
-  /// The smooth phase's ascent: the soft minimum (low beta) must rise.
-  void soft_ascent(int32_t i) {
-    const double h = scale(i);
-    if (!(h > 0)) return;
-    double step = 0.05 * h;
-    for (int iteration = 0; iteration < options_.ascent_steps; ++iteration) {
-      Vec3 gradient;
-      const double current = soft_min(i, gradient);
-      const Vec3 direction = slide_tangent(i, gradient);
-      if (!(direction.norm() > 1e-12 / h)) return;
-      const Vec3 unit = direction.normalized();
-      const Vec3 x = mesh_.points[problem_.nodes[i]];
-      bool moved = false;
-      for (int halving = 0; halving < 12; ++halving, step *= 0.5) {
-        SlideState s = state_[i];
-        const Vec3 candidate = slide_project(i, x + step * unit, s);
-        if (candidate == x || !(soft_min_at(i, candidate) > current + 1e-12)) continue;
-        double m;
-        if (!trial_min(i, candidate, m)) continue;
+        const bool better =
+            soft_phase_ ? soft_min_at(i, candidate) > current + 1e-12 && trial_min(i, candidate, m)
+                        : trial_min(i, candidate, m, nullptr, current + 1e-12);
+        if (!better) continue;
         commit(i, candidate, s);
+        if (!soft_phase_) current = m;
         moved = true;
         step = std::min(2 * step, 0.25 * h);
         break;

@@ -88,6 +88,15 @@ void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags)
       stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(t))] += known[t];
 }
 
+void refine_stats_finish(RefineStats& stats, const HexMesh& mesh, double seconds) {
+  stats.final_hexes = mesh.hex_count();
+  stats.final_nodes = mesh.point_count();
+  if (const std::vector<int32_t>* tags = mesh_find_attribute(mesh, attribute_template_tag))
+    stats_count_templates(stats, *tags);
+  stats.time_seconds = seconds;
+  stats.phase_seconds["total"] = seconds;
+}
+
 std::span<const RefineMethod> refine_methods() {
   return methods;
 }
@@ -173,11 +182,7 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
     current = &output;
   }
   result.mesh = std::move(output);
-  stats.final_hexes = result.mesh.hex_count();
-  stats.final_nodes = result.mesh.point_count();
-  stats_count_templates(stats, *mesh_find_attribute(result.mesh, attribute_template_tag));
-  stats.time_seconds = seconds_since(t0);
-  stats.phase_seconds["total"] = stats.time_seconds;
+  refine_stats_finish(stats, result.mesh, seconds_since(t0));
   return result;
 }
 

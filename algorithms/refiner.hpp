@@ -77,6 +77,10 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(
 /// Fills stats.hexes_per_template from a list of per-hex template tags.
 void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags);
 
+/// Completes the statistics of a refinement that produced `mesh` in `seconds`: final counts,
+/// hexes per template, time (and phase "total").
+void refine_stats_finish(RefineStats& stats, const HexMesh& mesh, double seconds);
+
 /// Output of a refinement: the new mesh (attributes "template_tag", "refinement_level",
 /// "parent_hex", plus the input's, inherited) and its statistics.
 struct RefineResult {

@@ -462,11 +462,7 @@ RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets, const Ref
     current = std::move(next);
   }
   result.mesh = std::move(current);
-  stats.final_hexes = result.mesh.hex_count();
-  stats.final_nodes = result.mesh.point_count();
-  stats_count_templates(stats, *mesh_find_attribute(result.mesh, attribute_template_tag));
-  stats.time_seconds = seconds_since(t0);
-  stats.phase_seconds["total"] = stats.time_seconds;
+  refine_stats_finish(stats, result.mesh, seconds_since(t0));
   return result;
 }
 

@@ -15,6 +15,8 @@
 
 #include "algorithms/sheet_rounds.hpp"
 
+#include "algorithms/sheet.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -79,15 +81,6 @@ Orientation orientation_make(const TemplateChoice& choice) {
     o.child_edge_nodes.push_back(edge_nodes);
   }
   return o;
-}
-
-uint16_t hex_marked_mask(const HexMesh& mesh, const std::vector<uint8_t>& marked, int32_t h) {
-  const HexCell& c = mesh.hexes[h];
-  uint16_t mask = 0;
-  for (int e = 0; e < 12; ++e)
-    if (marked[c[hex_edges[e][0]]] && marked[c[hex_edges[e][1]]])
-      mask |= static_cast<uint16_t>(1u << e);
-  return mask;
 }
 
 uint64_t hash_mix(uint64_t h, int64_t x) {
@@ -184,7 +177,7 @@ RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int3
         wanted |= axis_mask(k);
         occ[k] = -1;
       }
-    const uint16_t split = hex_marked_mask(mesh, state.node_marked, h) & wanted;
+    const uint16_t split = hex_split_mask(mesh, state.node_marked, h) & wanted;
     if (!split) continue;
     const Orientation* o = sheet_orientation(split);
     if (!o)
@@ -201,7 +194,7 @@ RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int3
   // Conformity by construction needs every hex around a split edge to split it in this round.
   for (const TemplateUse& u : plan.uses) {
     const int32_t h = index_of(u.hex);
-    const uint16_t split = hex_marked_mask(mesh, state.node_marked, h);
+    const uint16_t split = hex_split_mask(mesh, state.node_marked, h);
     for (int e = 0; e < 12; ++e) {
       if (!(split & (1u << e)) || !(axes_of[h] & (1u << hex_edge_axis[e]))) continue;
       const int32_t id = rt.hex_edge_ids[h][e];

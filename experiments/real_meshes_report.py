@@ -14,11 +14,12 @@ Exit status 2 on bad input.
 """
 
 import argparse
-import json
 import os
 import sys
 
 import matplotlib
+
+import records
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -28,37 +29,11 @@ PLACEMENTS = ["trilinear", "optimized"]
 
 
 def fail(message):
-    print("real_meshes_report.py: error: " + message, file=sys.stderr)
-    sys.exit(2)
-
-
-def read_records(path):
-    try:
-        with open(path, encoding="utf-8") as f:
-            lines = f.read().split("\n")
-    except OSError as e:
-        fail("%s: %s" % (path, e.strerror))
-    records = []
-    for number, line in enumerate(lines, 1):
-        if not line.strip():
-            continue
-        try:
-            records.append(json.loads(line))
-        except json.JSONDecodeError:
-            if number == len(lines):
-                continue  # a killed run's partial last line
-            fail("%s:%d: not a JSON record" % (path, number))
-    return records
+    records.fail("real_meshes_report.py", message)
 
 
 def fmt(value, digits=3):
-    if value is None:
-        return "–"
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, int):
-        return "{:,}".format(value)
-    return ("%." + str(digits) + "g") % value
+    return records.fmt(value, digits)
 
 
 def share_below(histogram, limit=0.2):
@@ -103,11 +78,11 @@ def main():
     parser.add_argument("--out", required=True)
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args()
-    records = [r for r in read_records(args.records)
-               if r.get("tags", {}).get("study") == "real_meshes"]
-    if not records:
+    study = [r for r in records.read_records(args.records, "real_meshes_report.py")
+             if r.get("tags", {}).get("study") == "real_meshes"]
+    if not study:
         fail("%s: no records of the real-mesh study" % args.records)
-    rows = [summarise(r) for r in records]
+    rows = [summarise(r) for r in study]
     os.makedirs(os.path.join(args.out, "plots"), exist_ok=True)
 
     out = ["# Real meshes: both refiners, both placements, smoothed\n",
@@ -117,8 +92,8 @@ def main():
            "`sphere:0,0,0,5`) x method x node placement, each output checked against its input, "
            "smoothed (`--smooth`: the refined region and two layers) and checked again. Quality "
            "is the scaled Jacobian; *parents* is the minimum over the input hexes that were "
-           "refined.\n" % (os.path.basename(args.records), len(records),
-                           records[0].get("commit", "?")[:12])]
+           "refined.\n" % (os.path.basename(args.records), len(study),
+                           study[0].get("commit", "?")[:12])]
 
     # Targets of the real-mesh issue.
     valid_inputs = [s for s in rows if not (s["error"] and "scaled Jacobian <= 0" in s["error"])

@@ -68,23 +68,8 @@ DualSheets dual_build(const HexMesh& mesh, const HexTopology& t, DualParts parts
   for (int32_t e = 0; e < t.edge_count(); ++e) ++d.sheets[d.edge_sheet[e]].edge_count;
 
   d.hex_sheet.resize(nh);
-  if (parts == DualParts::sheets) {
-    for (int32_t h = 0; h < nh; ++h) {
-      auto& hs = d.hex_sheet[h];
-      for (int axis = 0; axis < 3; ++axis)
-        hs[axis] = d.edge_sheet[t.hex_edge_ids[h][hex_axis_edges[axis][0]]];
-      for (int axis = 0; axis < 3; ++axis) {
-        bool seen_before = false;
-        for (int b = 0; b < axis; ++b) seen_before |= hs[b] == hs[axis];
-        if (seen_before)
-          d.sheets[hs[axis]].self_intersecting = true;
-        else
-          ++d.sheets[hs[axis]].hex_count;
-      }
-    }
-    return d;
-  }
-  d.sheet_hex_offsets.assign(static_cast<size_t>(sheet_count) + 1, 0);
+  const bool csr = parts == DualParts::all;
+  if (csr) d.sheet_hex_offsets.assign(static_cast<size_t>(sheet_count) + 1, 0);
   for (int32_t h = 0; h < nh; ++h) {
     auto& hs = d.hex_sheet[h];
     for (int axis = 0; axis < 3; ++axis)
@@ -97,9 +82,10 @@ DualSheets dual_build(const HexMesh& mesh, const HexTopology& t, DualParts parts
         continue;
       }
       ++d.sheets[hs[axis]].hex_count;
-      ++d.sheet_hex_offsets[hs[axis] + 1];
+      if (csr) ++d.sheet_hex_offsets[hs[axis] + 1];
     }
   }
+  if (!csr) return d;
   for (int32_t s = 0; s < sheet_count; ++s) d.sheet_hex_offsets[s + 1] += d.sheet_hex_offsets[s];
   d.sheet_hexes.resize(d.sheet_hex_offsets[sheet_count]);
   {

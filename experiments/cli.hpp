@@ -83,6 +83,7 @@ extern const CliCommand cli_run_command;
 extern const CliCommand cli_reproduce_command;
 extern const CliCommand cli_study_command;
 extern const CliCommand cli_merge_command;
+extern const CliCommand cli_templates_command;
 extern const CliCommand cli_bench_command;
 extern const CliCommand cli_bench_compare_command;
 

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include <set>
 
 #include "mesh/error.hpp"
@@ -63,7 +64,7 @@ TEST(Cli, EveryCommandExplainsItselfAndTheUsageListsEveryOption) {
       EXPECT_NE(top.output.find(o.name), std::string::npos) << c->name << " " << o.name;
     }
   }
-  EXPECT_EQ(names.size(), 12u);
+  EXPECT_EQ(names.size(), 13u);
   // The options the README documents are in the usage.
   for (const char* o : {"--threads", "--max-hexes", "--binary", "--placement", "--verbose"})
     EXPECT_NE(top.output.find(o), std::string::npos) << o;
@@ -74,6 +75,22 @@ TEST(Cli, EveryCommandExplainsItselfAndTheUsageListsEveryOption) {
   const CliRun unknown = cli_run("refin in out");
   EXPECT_EQ(unknown.exit_code, 2);
   EXPECT_NE(unknown.output.find("did you mean refine?"), std::string::npos) << unknown.output;
+}
+
+TEST(CliTemplates, ListsTheLibraryWithItsQualityAlone) {
+  const auto dir = test_temp_dir("cli_templates");
+  const std::string report = (dir / "t.json").string();
+  const CliRun r = cli_run("templates --report " + report);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("1-13"), std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(test_file_text(report));
+  ASSERT_EQ(j.size(), 8u);
+  EXPECT_EQ(j[1]["template"], "1-13");
+  EXPECT_NEAR(j[1]["min_scaled_jacobian_alone"].get<double>(), 4.0 / 13.0, 1e-12);
+  EXPECT_EQ(j[1]["children"], 13);
+  EXPECT_EQ(j[7]["template"], "1-9");
+  EXPECT_EQ(j[7]["sets"], nlohmann::json({"sheet_directional"}));
+  EXPECT_EQ(j[0]["sets"], nlohmann::json({"element_by_element", "sheet_directional"}));
 }
 
 }  // namespace

@@ -294,7 +294,17 @@ RefinementPlan SelectivePass::run() {
   stats_.phase_seconds["ranking"] += seconds_since(t2);
 
   auto t3 = Clock::now();
-  if (!options_.ebe_only) refine_directional();
+  if (!options_.ebe_only) {
+    // A cell that needs an input edge split is left as it is and the pass goes on, so one
+    // restart learns every such edge the pass meets; what goes wrong downstream of a skipped
+    // cell is moot once a restart is due.
+    try {
+      refine_directional();
+    } catch (const OperationError&) {
+      if (needed_input_edges_.empty()) throw;
+    }
+    if (!needed_input_edges_.empty()) throw InputEdgeSplitNeeded{needed_input_edges_};
+  }
   stats_.phase_seconds["directional"] += seconds_since(t3);
 
   auto t4 = Clock::now();
@@ -313,18 +323,29 @@ RefinementPlan selective_plan(const HexMesh& mesh, const HexTopology& topology,
   // with that edge split (each attempt splits one more edge, so this ends).
   std::vector<int32_t> forced;
   const RefineStats before = stats;
+  double restarted_seconds = 0;
   for (;;) {
+    const auto start = Clock::now();
     try {
       SelectivePass pass(mesh, topology, targets, options, stats, forced);
-      return pass.run();
+      RefinementPlan plan = pass.run();
+      stats.input_edges_forced = static_cast<int64_t>(forced.size());
+      stats.phase_seconds["restarted_passes"] = restarted_seconds;
+      return plan;
     } catch (const InputEdgeSplitNeeded& need) {
-      if (need.edge < 0 || std::find(forced.begin(), forced.end(), need.edge) != forced.end())
+      const size_t before_count = forced.size();
+      for (int32_t e : need.edges) {
+        if (e < 0)
+          throw OperationError(
+              "selective_refine: a directional adjustment needs an edge split "
+              "that lies on no input edge");
+        if (std::find(forced.begin(), forced.end(), e) == forced.end()) forced.push_back(e);
+      }
+      if (forced.size() == before_count)
         throw OperationError("selective_refine: cannot avoid a doublet at input edge " +
-                             std::to_string(need.edge));
-      forced.push_back(need.edge);
-      const auto phases = stats.phase_seconds;
+                             std::to_string(need.edges.front()));
+      restarted_seconds += seconds_since(start);
       stats = before;
-      stats.phase_seconds = phases;
     }
   }
 }

@@ -155,10 +155,13 @@ void CellRefiner::refine(const TemplateCell& cell, const HexTemplate& t, int sym
     out.key = node_key_at(mesh_, topology_, HexId{h}, out.param);
     out.aliased = !(resolve(out.key) == out.key);
   }
-  for (size_t i = 0; i < placed.size(); ++i)
-    for (size_t j = i + 1; j < placed.size(); ++j)
-      if (resolve(placed[i].key) == resolve(placed[j].key))
-        fail("two template nodes fall on one node (the cell is degenerate)");
+  // One lookup per node and a sort: a 1-27 template has 64 nodes, so pairwise lookups cost
+  // thousands of hash probes per cell.
+  std::vector<NodeKey> resolved(placed.size());
+  for (size_t i = 0; i < placed.size(); ++i) resolved[i] = resolve(placed[i].key);
+  std::sort(resolved.begin(), resolved.end(), node_key_less);
+  if (std::adjacent_find(resolved.begin(), resolved.end()) != resolved.end())
+    fail("two template nodes fall on one node (the cell is degenerate)");
   if (node_keys) {
     node_keys->resize(placed.size());
     for (size_t i = 0; i < placed.size(); ++i) (*node_keys)[i] = placed[i].key;

@@ -248,6 +248,7 @@ bool SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
       throw OperationError("selective_refine: hex " + std::to_string(c.hex) +
                            ": a sub-hex next to an adjustment needs further refinement (not "
                            "supported)");
+    bool needs_input_edge = false;
     if (template_is_adjusted(*d.choice.tmpl)) {
       // Appendix F at the cell level: the adjusted cell edge must have four faces and no
       // boundary face; an adjustment on an input edge or input face is checked like step 2.
@@ -299,13 +300,17 @@ bool SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
             return true;
           }
         }
-        if (bad && on == 2) throw InputEdgeSplitNeeded{cell_edge_input_edge(c, le)};
+        if (bad && on == 2) {
+          needed_input_edges_.push_back(cell_edge_input_edge(c, le));
+          needs_input_edge = true;
+          continue;
+        }
         if (bad)
           throw OperationError("selective_refine: hex " + std::to_string(c.hex) +
                                ": a directional adjustment would create a doublet");
       }
     }
-    out.push_back(d);
+    if (!needs_input_edge) out.push_back(d);
   }
   return false;
 }
@@ -360,7 +365,11 @@ void SelectivePass::refine_directional() {
           count_doublet(DoubletRule::cell_one_face_twice);
         return true;
       };
-      for (const Decision& dc : decisions) {
+      // A conflict no split inside a hex resolves needs an input edge split: the decision is
+      // dropped and the pass goes on (it restarts at its end, SelectivePass::run).
+      std::vector<uint8_t> dropped(decisions.size(), 0);
+      for (size_t i = 0; i < decisions.size(); ++i) {
+        const Decision& dc = decisions[i];
         if (!template_is_adjusted(*dc.choice.tmpl)) continue;
         const TemplateCell& c = cells_[dc.di][dc.cell];
         pairs.clear();
@@ -368,17 +377,24 @@ void SelectivePass::refine_directional() {
         for (const AliasPair& p : pairs) {
           const auto [it, inserted] = round_alias.emplace(p.from, Owner{p.to, &c, p.edge});
           if (inserted || it->second.to == p.to) continue;
-          if (!split_inside(c, p.edge) && !split_inside(*it->second.cell, it->second.edge)) {
-            for (const auto& [cc, ee] :
-                 {std::pair{&c, p.edge}, {it->second.cell, it->second.edge}}) {
-              const int32_t ie = cell_edge_input_edge(*cc, ee);
-              if (ie >= 0) throw InputEdgeSplitNeeded{ie};
-            }
+          if (split_inside(c, p.edge) || split_inside(*it->second.cell, it->second.edge)) {
+            again = true;
+            continue;
+          }
+          int32_t ie = cell_edge_input_edge(c, p.edge);
+          if (ie < 0) ie = cell_edge_input_edge(*it->second.cell, it->second.edge);
+          if (ie < 0)
             throw OperationError("selective_refine: hex " + std::to_string(c.hex) +
                                  ": two directional adjustments collapse one face (a doublet)");
-          }
-          again = true;
+          needed_input_edges_.push_back(ie);
+          dropped[i] = 1;
         }
+      }
+      if (!again && std::find(dropped.begin(), dropped.end(), 1) != dropped.end()) {
+        size_t kept = 0;
+        for (size_t i = 0; i < decisions.size(); ++i)
+          if (!dropped[i]) decisions[kept++] = decisions[i];
+        decisions.resize(kept);
       }
     }
     for (const Decision& dc : decisions) {

@@ -30,10 +30,15 @@ enum class DoubletRule : uint8_t {
 };
 const char* doublet_rule_name(DoubletRule rule);
 
-/// Thrown when directional refinement meets an adjustment it can only avoid by splitting an input
-/// edge (Appendix F): the pass starts again with that edge split from the outset.
+/// Thrown when directional refinement meets adjustments it can only avoid by splitting input
+/// edges (Appendix F): the pass starts again with those edges split from the outset. The pass
+/// skips such cells and goes on to collect every such edge it meets before throwing (two
+/// adjustments collapsing one face stop it at once), so a mesh that needs many costs a few
+/// restarts rather than one per edge. The edges a skipped cell's neighbours then name may be
+/// more than one-at-a-time restarts would split: a few more hexes, never an invalid mesh (the
+/// last pass runs clean).
 struct InputEdgeSplitNeeded {
-  int32_t edge;
+  std::vector<int32_t> edges;
 };
 
 /// A segment between two keyed nodes (ordered), for the split state of edges made by
@@ -121,6 +126,7 @@ class SelectivePass {
   // Rounds of (directional index, input axis), in processing order.
   std::vector<std::vector<std::pair<int32_t, int8_t>>> rounds_;
   std::unordered_set<SegmentKey, SegmentKeyHash> split_segments_;
+  std::vector<int32_t> needed_input_edges_;  // of the current round (InputEdgeSplitNeeded)
 };
 
 /// Split mask of hex h (bit e: local edge e split).

@@ -1,0 +1,252 @@
+"""Tests of the Python module over the C++ library: the thesis counts through Python, round trips
+numpy <-> HexMesh <-> files <-> meshio, the errors for bad arrays and specs, and an ablation loop
+written the way a user writes one. Run by ctest (label python) with PYTHONPATH on the build tree."""
+
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import hexrefine
+
+SHARED = pathlib.Path(os.environ.get("HEXREFINE_SHARED_DIR", "../shared"))
+L_SHAPE = ["boundary:-1,0,0", "boundary:0,0,-1"]
+
+
+def unit_cube():
+    points = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
+                       [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], dtype=float)
+    return points, np.arange(8, dtype=np.int64).reshape(1, 8)
+
+
+@pytest.fixture(scope="module")
+def brick10():
+    return hexrefine.generate("brick", dims=[10, 10, 10], size=[1.0, 1.0, 1.0])
+
+
+# --- the thesis' G-1 through Python --------------------------------------------------------------
+
+@pytest.mark.parametrize("method,hexes", [("selective", 8060), ("sheet", 27000)])
+def test_g1_counts_match_the_thesis(brick10, method, hexes):
+    refined, report = hexrefine.refine(brick10, L_SHAPE, method=method, placement="trilinear")
+    assert refined.hex_count == hexes
+    assert report["refine"]["final_hexes"] == hexes
+    assert report["check"]["valid"] and report["check"]["conformal"]
+    assert report["check"]["non_conformal_faces"] == 0
+    assert report["method"] == method
+    # Every output hex names its input hex; the untouched ones keep level 0.
+    parents = refined.attributes["parent_hex"]
+    assert parents.shape == (hexes,)
+    assert parents.min() >= 0 and parents.max() < brick10.hex_count
+    assert set(refined.attributes) >= {"parent_hex", "template_tag", "refinement_level"}
+
+
+def test_g1_selective_min_scaled_jacobian_is_the_thesis_value(brick10):
+    refined, report = hexrefine.refine(brick10, L_SHAPE, placement="trilinear")
+    q = hexrefine.quality(refined)
+    assert q.shape == (8060,)
+    assert q.min() == pytest.approx(4.0 / 13.0, abs=1e-9)  # 0.3077, the 1-13 template's corner
+    assert report["check"]["min_scaled_jacobian"] == pytest.approx(q.min(), abs=1e-12)
+
+
+def test_optimized_placement_beats_trilinear_on_g1(brick10):
+    trilinear, _ = hexrefine.refine(brick10, L_SHAPE, placement="trilinear")
+    optimized, report = hexrefine.refine(brick10, L_SHAPE)
+    assert optimized.hex_count == trilinear.hex_count
+    np.testing.assert_array_equal(optimized.hexes, trilinear.hexes)  # placement moves, never adds
+    assert hexrefine.quality(optimized).min() > hexrefine.quality(trilinear).min() + 0.05
+    assert report["options"]["placement"]["method"] == "optimized"
+
+
+def test_refine_accepts_ids_as_array_list_and_specs_alike(brick10):
+    ids = hexrefine.select(brick10, L_SHAPE)
+    assert ids.dtype == np.int32 and np.all(np.diff(ids) > 0)
+    assert len(ids) == 190  # two 10 x 10 layers sharing a 10-hex edge row
+    by_spec, _ = hexrefine.refine(brick10, L_SHAPE, placement="trilinear")
+    by_array, _ = hexrefine.refine(brick10, ids, placement="trilinear")
+    by_list, _ = hexrefine.refine(brick10, [int(i) for i in ids[::-1]], placement="trilinear")
+    np.testing.assert_array_equal(by_spec.hexes, by_array.hexes)
+    np.testing.assert_array_equal(by_spec.hexes, by_list.hexes)
+
+
+# --- round trips ---------------------------------------------------------------------------------
+
+def test_arrays_round_trip_through_hexmesh():
+    points, hexes = unit_cube()
+    mesh = hexrefine.HexMesh(points, hexes, {"block_id": np.array([7])})
+    np.testing.assert_array_equal(mesh.points, points)
+    np.testing.assert_array_equal(mesh.hexes, hexes)
+    assert mesh.hexes.dtype == np.int32 and mesh.points.dtype == np.float64
+    assert mesh.attributes["block_id"].tolist() == [7]
+    assert hexrefine.quality(mesh).tolist() == [1.0]
+    assert hexrefine.quality(mesh, "volume").tolist() == [pytest.approx(1.0)]
+
+
+@pytest.mark.parametrize("extension", [".vtu", ".vtk", ".mesh", ".e", ".msh"])
+def test_refined_mesh_round_trips_through_files(brick10, tmp_path, extension):
+    refined, _ = hexrefine.refine(brick10, "sphere:0,0,0,0.35")
+    path = str(tmp_path / ("refined" + extension))
+    hexrefine.write(refined, path)
+    back = hexrefine.read(path)
+    assert back.hex_count == refined.hex_count and back.point_count == refined.point_count
+    np.testing.assert_array_equal(back.hexes, refined.hexes)
+    np.testing.assert_allclose(back.points, refined.points, rtol=0, atol=1e-12)
+    assert hexrefine.check(back)["valid"]
+
+
+def test_refined_mesh_round_trips_through_meshio(brick10):
+    meshio = pytest.importorskip("meshio")
+    refined, _ = hexrefine.refine(brick10, "sphere:0,0,0,0.35", method="sheet")
+    m = hexrefine.to_meshio(refined)
+    assert isinstance(m, meshio.Mesh) and m.cells[0].type == "hexahedron"
+    back = hexrefine.from_meshio(m)
+    np.testing.assert_array_equal(back.hexes, refined.hexes)
+    np.testing.assert_array_equal(back.points, refined.points)
+    for name, values in refined.attributes.items():
+        np.testing.assert_array_equal(back.attributes[name], values)
+
+
+def test_from_meshio_refuses_other_volume_cells():
+    meshio = pytest.importorskip("meshio")
+    m = meshio.Mesh(np.eye(4, 3), [("tetra", np.array([[0, 1, 2, 3]]))])
+    with pytest.raises(ValueError, match="tetra"):
+        hexrefine.from_meshio(m)
+
+
+def test_real_mesh_refines_valid_with_both_methods():
+    path = SHARED / "meshes" / "rockerarm.mesh"
+    if not path.exists():
+        pytest.skip("shared meshes not present")
+    mesh = hexrefine.read(str(path))
+    targets = hexrefine.select(mesh, "random:0.02,7")
+    assert len(targets) > 0
+    for method in hexrefine.methods():
+        refined, report = hexrefine.refine(mesh, targets, method=method)
+        check = hexrefine.check(refined, mesh)
+        assert check["valid"] and check["inverted_hexes"] == 0, method
+        assert check["geometry_preserved"], method
+        assert report["check"]["min_scaled_jacobian"] > 0, method
+        assert refined.hex_count > mesh.hex_count, method
+
+
+# --- errors --------------------------------------------------------------------------------------
+
+def test_wrong_shapes_are_refused():
+    points, hexes = unit_cube()
+    with pytest.raises(ValueError, match=r"points: expected .* \(n, 3\)"):
+        hexrefine.HexMesh(points[:, :2], hexes)
+    with pytest.raises(ValueError, match=r"hexes: expected .* \(m, 8\)"):
+        hexrefine.HexMesh(points, hexes[:, :6])
+    with pytest.raises(ValueError, match="hexes: expected an integer array"):
+        hexrefine.HexMesh(points, hexes.astype(float))
+    with pytest.raises(ValueError, match="attribute 'block_id'"):
+        hexrefine.HexMesh(points, hexes, {"block_id": np.array([1, 2])})
+
+
+def test_out_of_range_ids_name_the_hex_and_node():
+    points, hexes = unit_cube()
+    bad = hexes.copy()
+    bad[0, 5] = 8
+    with pytest.raises(ValueError, match=r"hex 0, node 5: id 8 out of range 0\.\.7"):
+        hexrefine.HexMesh(points, bad)
+    bad[0, 5] = -1
+    with pytest.raises(ValueError, match="hex 0, node 5"):
+        hexrefine.HexMesh(points, bad)
+
+
+def test_repeated_node_and_nan_are_refused():
+    points, hexes = unit_cube()
+    bad = hexes.copy()
+    bad[0, 6] = 0
+    with pytest.raises(ValueError, match="hex 0"):
+        hexrefine.HexMesh(points, bad)
+    nan = points.copy()
+    nan[3, 1] = np.nan
+    with pytest.raises(ValueError, match="point 3 has a NaN"):
+        hexrefine.HexMesh(nan, hexes)
+
+
+def test_bad_specs_options_and_files_are_value_errors(brick10, tmp_path):
+    with pytest.raises(ValueError, match="sphere"):
+        hexrefine.select(brick10, "sphere:1,2")
+    with pytest.raises(ValueError, match="out of range"):
+        hexrefine.refine(brick10, np.array([1000]))
+    with pytest.raises(ValueError, match="placement"):
+        hexrefine.refine(brick10, [0], placement="random")
+    with pytest.raises(ValueError):
+        hexrefine.refine(brick10, [0], method="octree")
+    with pytest.raises(ValueError, match="metric"):
+        hexrefine.quality(brick10, "aspect")
+    with pytest.raises(ValueError, match="brick"):
+        hexrefine.generate("brik")
+    bad = tmp_path / "bad.mesh"
+    bad.write_text("MeshVersionFormatted 2\nDimension 3\nVertices\n2\n0 0 0 0\n")
+    with pytest.raises(ValueError, match="bad.mesh"):
+        hexrefine.read(str(bad))
+
+
+def test_ablation_without_propagation_reports_non_conformal_faces(brick10):
+    # An ablation switch is not a refusal: the output comes back and the checker counts the faces
+    # the directional cells leave non-conformal without the propagation scheme.
+    ids = hexrefine.select(brick10, "random:0.05,0")
+    refined, report = hexrefine.refine(brick10, ids, propagation=False, placement="trilinear")
+    assert report["options"]["propagation"] is False
+    assert report["check"]["non_conformal_faces"] == 1512
+    assert not report["check"]["valid"]
+    assert refined.hex_count == 5794
+
+
+# --- an ablation loop the way a user writes one --------------------------------------------------
+
+def test_ablation_loop_over_seeded_random_targets(brick10):
+    rows = []
+    for seed in range(3):
+        targets = hexrefine.select(brick10, f"random:0.05,{seed}")
+        for ranking in (True, False):
+            for propagation in (True, False):
+                refined, report = hexrefine.refine(brick10, targets, ranking=ranking,
+                                                   propagation=propagation,
+                                                   placement="trilinear")
+                rows.append({"seed": seed, "ranking": ranking, "propagation": propagation,
+                             "hexes": refined.hex_count,
+                             "non_conformal": report["check"]["non_conformal_faces"]})
+    assert len(rows) == 12
+    by_key = {(r["seed"], r["ranking"], r["propagation"]): r for r in rows}
+    for seed in range(3):
+        # Propagation is what makes the output conformal; ranking is what keeps it small.
+        assert by_key[seed, True, True]["non_conformal"] == 0
+        assert by_key[seed, False, True]["non_conformal"] == 0
+        assert by_key[seed, True, False]["non_conformal"] > 0
+        assert by_key[seed, False, True]["hexes"] > by_key[seed, True, True]["hexes"]
+    assert [by_key[s, True, True]["hexes"] for s in range(3)] == [5892, 4937, 6864]
+    # The records are plain JSON: what a user saves beside a plot.
+    assert json.loads(json.dumps(rows)) == rows
+
+
+def test_run_yields_the_records_of_the_command_line(tmp_path):
+    cases = {"cases": [{"name": "g1", "mesh": {"generate": "brick", "dims": [10, 10, 10]},
+                        "select": L_SHAPE, "methods": ["selective", "sheet"],
+                        "options": {"placement": "trilinear"}}]}
+    records = hexrefine.run(cases, str(tmp_path / "out.jsonl"))
+    assert [r["method"] for r in records] == ["selective", "sheet"]
+    assert [r["refine"]["final_hexes"] for r in records] == [8060, 27000]
+    assert all(r["check"]["valid"] for r in records)
+    lines = (tmp_path / "out.jsonl").read_text().splitlines()
+    assert len(lines) == 2
+
+
+def test_ablation_example_runs_and_writes_its_records(tmp_path):
+    script = pathlib.Path(os.environ.get("HEXREFINE_SOURCE_DIR", ".")) / "experiments" / \
+        "examples" / "ablation.py"
+    out = tmp_path / "ablation.json"
+    subprocess.run([sys.executable, str(script), "--quick", "--seeds", "2", "--placement",
+                    "trilinear", "--json", str(out)], check=True, capture_output=True)
+    records = json.loads(out.read_text())["records"]
+    assert len(records) == 8  # 1 mesh x 2 seeds x 4 variants
+    full = [r for r in records if r["variant"] == "full"]
+    assert all(r["non_conformal_faces"] == 0 and r["valid"] for r in full)
+    assert all(r["non_conformal_faces"] > 0 for r in records if not r["propagation"])

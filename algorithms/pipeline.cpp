@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <iomanip>
 #include <numeric>
 #include <ostream>
@@ -23,23 +24,34 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-/// Ends a stage: its time goes to the result and, with --verbose, to the stream.
+/// CPU time of this process (all its threads).
+double process_cpu_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+/// Ends a stage: its wall and CPU time go to the result and, with --verbose, to the stream.
 class StageClock {
  public:
   StageClock(PipelineResult& result, std::ostream* verbose) : result_(result), verbose_(verbose) {}
   void end(const std::string& stage) {
     const double s = seconds_since(start_);
+    const double cpu = process_cpu_seconds();
     result_.stage_seconds[stage] += s;
+    result_.stage_cpu_seconds[stage] += cpu - cpu_start_;
     if (verbose_)
       *verbose_ << "hexrefine: " << stage << " " << std::fixed << std::setprecision(3) << s << " s"
                 << std::endl;
     start_ = Clock::now();
+    cpu_start_ = cpu;
   }
 
  private:
   PipelineResult& result_;
   std::ostream* verbose_;
   Clock::time_point start_ = Clock::now();
+  double cpu_start_ = process_cpu_seconds();
 };
 
 /// n * 27^passes, saturated at INT64_MAX.
@@ -202,6 +214,7 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
     write_clock.end("write");
   }
   r.stage_seconds["read"] = scratch.stage_seconds["read"];
+  r.stage_cpu_seconds["read"] = scratch.stage_cpu_seconds["read"];
   r.stage_seconds["total"] = seconds_since(start);
   r.peak_memory_mb = process_peak_memory_mb();
   return r;
@@ -225,6 +238,7 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
   j["check"] = r.check;
   if (r.smoothing) j["smoothing"] = {{"stats", *r.smoothing}, {"check", *r.smoothed_check}};
   j["stage_seconds"] = r.stage_seconds;
+  j["stage_cpu_seconds"] = r.stage_cpu_seconds;
   j["peak_memory_mb"] = r.peak_memory_mb;
   return j;
 }

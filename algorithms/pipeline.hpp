@@ -74,6 +74,9 @@ struct PipelineResult {
   /// Seconds per stage: read, select, refine, check, smooth, check_smoothed, write, total
   /// (read and write only from pipeline_run_files).
   std::map<std::string, double> stage_seconds;
+  /// Process CPU seconds per stage (all threads): on a shared machine the better measure of
+  /// single-threaded stages, whose wall time includes waiting.
+  std::map<std::string, double> stage_cpu_seconds;
   double peak_memory_mb = 0;  ///< the process's peak resident size when the pipeline ended
   /// A refinement switch that may give a non-conformal mesh by design (ablation).
   bool ablation = false;
@@ -93,7 +96,7 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
 /// The report: "method", "options" (RefineOptions plus "smooth"), "selection" ({"specs",
 /// "hexes", "warning"?}), "refine" (RefineStats), "refined_parents" ({"hexes",
 /// "min_scaled_jacobian"}), "check", "smoothing"? ({"stats", "check"}), "stage_seconds",
-/// "peak_memory_mb". The CLI writes it with --report, the runner adds its
+/// "stage_cpu_seconds", "peak_memory_mb". The CLI writes it with --report, the runner adds its
 /// identification fields to it, the Python module returns it as a dict.
 nlohmann::json pipeline_report(const PipelineResult& result, const PipelineOptions& options);
 

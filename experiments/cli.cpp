@@ -62,9 +62,11 @@ size_t edit_distance(const std::string& a, const std::string& b) {
 
 const std::vector<const CliCommand*>& cli_commands() {
   static const std::vector<const CliCommand*> commands = {
-      &cli_generate_command, &cli_check_command,  &cli_convert_command, &cli_sheets_command,
-      &cli_refine_command,   &cli_smooth_command, &cli_run_command,     &cli_reproduce_command,
-      &cli_study_command,    &cli_merge_command, &cli_templates_command,  &cli_bench_command,   &cli_bench_compare_command};
+      &cli_generate_command,     &cli_check_command,     &cli_convert_command,
+      &cli_sheets_command,       &cli_refine_command,    &cli_smooth_command,
+      &cli_run_command,          &cli_reproduce_command, &cli_study_command,
+      &cli_merge_command,        &cli_templates_command, &cli_bench_command,
+      &cli_bench_compare_command};
   return commands;
 }
 

@@ -14,6 +14,10 @@
 /// 1 to 6 s a run) only under HEXREFINE_BENCH_LARGE=1. A refiner that throws (e.g. not implemented
 /// yet) is reported as a skipped benchmark with its message.
 ///
+/// The refiners run with the thesis' trilinear node placement (the template engine's output as
+/// the baseline measured it); `selective_optimized` and `sheet_optimized` add the default
+/// optimized placement, whose cost is the difference.
+///
 /// Run (Release): bench_refiners --benchmark_repetitions=3
 ///   --benchmark_out=results/benchmarks/refiners.json --benchmark_out_format=json
 #include <benchmark/benchmark.h>
@@ -91,8 +95,14 @@ Targets targets_block(const HexMesh& m, int32_t block) {
   return t;
 }
 
+RefineOptions trilinear_options() {
+  RefineOptions o;
+  o.placement.method = PlacementMethod::trilinear;
+  return o;
+}
+
 void run(benchmark::State& state, RefineFunction refine, const HexMesh& mesh,
-         const Targets& targets, const RefineOptions& options = {}) {
+         const Targets& targets, const RefineOptions& options = trilinear_options()) {
   RefineStats last;
   bench_reset_peak_memory();
   std::vector<double> seconds;
@@ -172,7 +182,7 @@ void bench_left_three_passes(benchmark::State& state, RefineFunction refine) {
   for (int k = 0; k < 4; ++k)
     for (int j = 0; j < 4; ++j) left.hexes.push_back(brick_hex({4, 4, 4}, 0, j, k));
   std::sort(left.hexes.begin(), left.hexes.end());
-  RefineOptions options;
+  RefineOptions options = trilinear_options();
   options.passes = 3;
   options.buffer = refine == selective;
   run(state, refine, mesh, left, options);
@@ -210,6 +220,20 @@ RefineResult sheet_2_threads(const HexMesh& mesh, const Targets& targets,
   return sheet_refine(mesh, targets, o);
 }
 
+// Both refiners with the default optimized node placement.
+RefineResult selective_optimized(const HexMesh& mesh, const Targets& targets,
+                                 const RefineOptions& options) {
+  RefineOptions o = options;
+  o.placement.method = PlacementMethod::optimized;
+  return selective_refine(mesh, targets, o);
+}
+RefineResult sheet_optimized(const HexMesh& mesh, const Targets& targets,
+                             const RefineOptions& options) {
+  RefineOptions o = options;
+  o.placement.method = PlacementMethod::optimized;
+  return sheet_refine(mesh, targets, o);
+}
+
 void sizes(benchmark::internal::Benchmark* b) {
   bench_brick_sizes(b, 10, 10);
 }
@@ -230,12 +254,20 @@ BENCHMARK_CAPTURE(bench_full_brick, sheet_one_per_pass, &sheet_one_per_pass)
 BENCHMARK_CAPTURE(bench_radial, sheet, sheet)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_radial, selective, selective)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_radial, sheet_rounds, &sheet_rounds)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_radial, selective_optimized, &selective_optimized)->Apply(sizes);
+BENCHMARK_CAPTURE(bench_radial, sheet_optimized, &sheet_optimized)->Apply(sizes);
 BENCHMARK_CAPTURE(bench_l_shaped, sheet, sheet)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(bench_l_shaped, selective, selective)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(bench_gear_teeth, sheet, sheet)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(bench_gear_teeth, selective, selective)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(bench_gear_teeth, selective_optimized, &selective_optimized)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(bench_gear_teeth, sheet_optimized, &sheet_optimized)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

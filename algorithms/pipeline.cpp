@@ -169,7 +169,7 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
       }
   }
 
-  r.check = mesh_check(r.mesh, &input);
+  r.check = mesh_check(r.mesh, &input, o.refine.threads);
   clock.end("check");
   verdict_enforce(r.check, r.mesh, input, o, r.ablation, "the " + o.method + " refiner");
 
@@ -185,7 +185,7 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
       so.reference_nodes = input.point_count();
       r.smoothing = mesh_smooth(r.mesh, so);
       clock.end("smooth");
-      r.smoothed_check = mesh_check(r.mesh, &input);
+      r.smoothed_check = mesh_check(r.mesh, &input, o.refine.threads);
       clock.end("check_smoothed");
       verdict_enforce(*r.smoothed_check, r.mesh, input, o, r.ablation, "smoothing");
     }

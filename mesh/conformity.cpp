@@ -10,9 +10,10 @@
 #include <unordered_map>
 
 #include "mesh/hex_convention.hpp"
+#include "mesh/hex_face_adjacency.hpp"
+#include "mesh/parallel.hpp"
 #include "mesh/quad_patch.hpp"
 #include "mesh/quality.hpp"
-#include "mesh/topology.hpp"
 
 namespace hexrefine {
 
@@ -110,21 +111,24 @@ class QuadGrid {
   std::vector<int32_t> offsets_, items_, fill_;
 };
 
-/// Boundary surface of a mesh: face ids, their node ids (outward from their hex) and positions.
+/// Boundary surface of a mesh: its boundary face slots, their node ids (outward from their hex)
+/// and positions.
 struct BoundarySurface {
-  std::vector<int32_t> faces;
+  std::vector<HexFaceSlot> slots;
   std::vector<std::array<int32_t, 4>> nodes;
   std::vector<Quad> quads;
   std::vector<double> tolerances;  ///< surface tolerance x diameter, per face
 };
 
-BoundarySurface boundary_surface(const HexMesh& mesh, const HexTopology& t) {
+BoundarySurface boundary_surface(const HexMesh& mesh, std::vector<HexFaceSlot> slots) {
   BoundarySurface s;
-  s.faces = topology_boundary_faces(t);
-  s.nodes.reserve(s.faces.size());
-  s.quads.reserve(s.faces.size());
-  for (int32_t f : s.faces) {
-    const auto& n = t.face_nodes[f];
+  s.slots = std::move(slots);
+  s.nodes.reserve(s.slots.size());
+  s.quads.reserve(s.slots.size());
+  for (const HexFaceSlot& slot : s.slots) {
+    const HexCell& c = mesh.hexes[slot.hex];
+    const int* fv = hex_faces[slot.local_face];
+    const std::array<int32_t, 4> n = {c[fv[0]], c[fv[1]], c[fv[2]], c[fv[3]]};
     s.nodes.push_back(n);
     s.quads.push_back({mesh.points[n[0]], mesh.points[n[1]], mesh.points[n[2]], mesh.points[n[3]]});
     // A point averaged from patch points (a sub-face centroid, a node placed by a template whose
@@ -146,11 +150,12 @@ double mesh_volume(const HexMesh& mesh) {
   return volume;
 }
 
-/// Nodes within mesh_check_duplicate_tolerance x diagonal of a lower-id node. Points are sorted
-/// by a coarse cell (about one point per cell); near pairs share a cell unless they straddle a
-/// cell wall, so only points within the tolerance of a wall also search the neighbouring cells.
-/// The cell size is an irrational multiple of the mean spacing so structured grids do not put
-/// their points on the walls. Worst case (many points in one cell) is quadratic in that cell.
+/// Nodes within mesh_check_duplicate_tolerance x diagonal of a lower-id node. Points are
+/// bucketed by a coarse cell (about four points per cell, one counting sort); near pairs share a
+/// cell unless they straddle a cell wall, so only points within the tolerance of a wall also
+/// search the neighbouring cells. The cell size is an irrational multiple of the mean spacing so
+/// structured grids do not put their points on the walls. Worst case (many points in one cell)
+/// is quadratic in that cell.
 int64_t count_duplicate_nodes(const HexMesh& mesh) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
@@ -161,32 +166,42 @@ int64_t count_duplicate_nodes(const HexMesh& mesh) {
       std::max({1.6180339887 * extent / std::cbrt(static_cast<double>(n)), 4.0 * tolerance,
                 extent / double(1 << 20), std::numeric_limits<double>::min() * 1e10});
   const Eigen::Vector3d origin = lo - Eigen::Vector3d::Constant(0.3819660113 * cell);
+  // At most cbrt(n) / 1.618 + 2 cells per axis by the cell size above, so about n / 4 cells.
+  std::array<int64_t, 3> dims;
+  for (int d = 0; d < 3; ++d)
+    dims[d] = std::clamp<int64_t>(static_cast<int64_t>((hi[d] - origin[d]) / cell) + 1, 1,
+                                  int64_t{1} << 21);
   auto cell_index = [&](double x, int d) {
-    return static_cast<int64_t>(std::floor((x - origin[d]) / cell));
+    const double k = std::floor((x - origin[d]) / cell);
+    return k >= 0.0 ? std::min(static_cast<int64_t>(k), dims[d] - 1) : int64_t{0};  // NaN: 0
   };
-  auto pack = [](int64_t x, int64_t y, int64_t z) {
-    const uint64_t mask = 0x1FFFFF;  // indices stay in [0, 2^20 + 2) by the cell size above
-    return ((static_cast<uint64_t>(x) & mask) << 42) | ((static_cast<uint64_t>(y) & mask) << 21) |
-           (static_cast<uint64_t>(z) & mask);
-  };
-  std::vector<std::pair<uint64_t, int32_t>> sorted(n);
+  auto cell_of = [&](int64_t x, int64_t y, int64_t z) { return (z * dims[1] + y) * dims[0] + x; };
+  const int64_t cells = dims[0] * dims[1] * dims[2];
+  std::vector<int64_t> cell_of_point(n);
+  std::vector<uint32_t> cell_end(static_cast<size_t>(cells), 0);  // counts, starts, then ends
   for (int32_t i = 0; i < n; ++i) {
     const Eigen::Vector3d& p = mesh.points[i];
-    sorted[i] = {pack(cell_index(p[0], 0), cell_index(p[1], 1), cell_index(p[2], 2)), i};
+    cell_of_point[i] = cell_of(cell_index(p[0], 0), cell_index(p[1], 1), cell_index(p[2], 2));
+    ++cell_end[cell_of_point[i]];
   }
-  std::sort(sorted.begin(), sorted.end());
+  uint32_t running = 0;
+  for (uint32_t& c : cell_end) {
+    const uint32_t count = c;
+    c = running;
+    running += count;
+  }
+  std::vector<int32_t> sorted(n);
+  for (int32_t i = 0; i < n; ++i) sorted[cell_end[cell_of_point[i]]++] = i;
+  auto cell_begin = [&](int64_t c) { return c == 0 ? uint32_t{0} : cell_end[c - 1]; };
+
   std::vector<char> duplicate(n, 0);
   auto compare = [&](int32_t i, int32_t j) {
     if (i != j && (mesh.points[i] - mesh.points[j]).norm() <= tolerance)
       duplicate[std::max(i, j)] = 1;
   };
-  for (size_t begin = 0; begin < sorted.size();) {
-    size_t end = begin + 1;
-    while (end < sorted.size() && sorted[end].first == sorted[begin].first) ++end;
-    for (size_t a = begin; a < end; ++a)
-      for (size_t b = a + 1; b < end; ++b) compare(sorted[a].second, sorted[b].second);
-    begin = end;
-  }
+  for (int64_t c = 0; c < cells; ++c)
+    for (uint32_t a = cell_begin(c); a < cell_end[c]; ++a)
+      for (uint32_t b = a + 1; b < cell_end[c]; ++b) compare(sorted[a], sorted[b]);
   for (int32_t i = 0; i < n; ++i) {
     const Eigen::Vector3d& p = mesh.points[i];
     int64_t k[3];
@@ -195,8 +210,8 @@ int64_t count_duplicate_nodes(const HexMesh& mesh) {
     for (int d = 0; d < 3; ++d) {
       k[d] = cell_index(p[d], d);
       const double wall = origin[d] + static_cast<double>(k[d]) * cell;
-      low[d] = p[d] - wall <= tolerance ? -1 : 0;
-      high[d] = wall + cell - p[d] <= tolerance ? 1 : 0;
+      low[d] = k[d] > 0 && p[d] - wall <= tolerance ? -1 : 0;
+      high[d] = k[d] + 1 < dims[d] && wall + cell - p[d] <= tolerance ? 1 : 0;
       near_wall = near_wall || low[d] || high[d];
     }
     if (!near_wall) continue;
@@ -204,10 +219,8 @@ int64_t count_duplicate_nodes(const HexMesh& mesh) {
       for (int dy = low[1]; dy <= high[1]; ++dy)
         for (int dx = low[0]; dx <= high[0]; ++dx) {
           if (dx == 0 && dy == 0 && dz == 0) continue;
-          const uint64_t key = pack(k[0] + dx, k[1] + dy, k[2] + dz);
-          auto it =
-              std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(key, int32_t{-1}));
-          for (; it != sorted.end() && it->first == key; ++it) compare(i, it->second);
+          const int64_t c = cell_of(k[0] + dx, k[1] + dy, k[2] + dz);
+          for (uint32_t b = cell_begin(c); b < cell_end[c]; ++b) compare(i, sorted[b]);
         }
   }
   return std::count(duplicate.begin(), duplicate.end(), 1);
@@ -221,13 +234,13 @@ int scaled_jacobian_bin(double v) {
 
 }  // namespace
 
-MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
+MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int threads) {
   mesh_validate_ids(mesh, "mesh");
   if (reference) mesh_validate_ids(*reference, "reference mesh");
   MeshCheckReport r;
   r.hexes = mesh.hex_count();
   r.nodes = mesh.point_count();
-  // Unused and duplicate nodes first: their work arrays are gone before the topology is built.
+  // Unused and duplicate nodes first: their work arrays are gone before the faces are matched.
   {
     std::vector<char> used(mesh.points.size(), 0);
     for (const HexCell& c : mesh.hexes)
@@ -235,59 +248,74 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
     r.unused_nodes = std::count(used.begin(), used.end(), 0);
   }
   r.duplicate_nodes = count_duplicate_nodes(mesh);
-  // Faces only: the check needs no edge table (boundary edges are counted below from the
-  // boundary faces alone), which keeps the memory of checking a large output down.
-  const HexTopology t = topology_build(mesh, TopologyParts::faces);
-  r.nonmanifold_faces = static_cast<int64_t>(t.nonmanifold_faces.size());
+  HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, threads);
+  r.nonmanifold_faces = static_cast<int64_t>(adjacency.nonmanifold_faces.size());
 
-  // Quality and volume.
-  std::vector<int32_t> defects;  // hexes with a defect (a few, for messages)
-  auto defect = [&](int32_t h) {
-    if (defects.size() < 4 * mesh_check_defect_hex_limit) defects.push_back(h);
+  // Hexes with a defect: every source offers its lowest mesh_check_defect_hex_limit, so the
+  // report lists the lowest overall.
+  std::vector<int32_t> defects;
+  for (const HexFaceSlot& f : adjacency.nonmanifold_faces) defects.push_back(f.hex);
+
+  // Quality, volume and doublets (a neighbour met across two local faces of the same hex), per
+  // fixed chunk of hexes so the sums do not depend on the thread count.
+  struct ChunkSums {
+    double scaled_jacobian_sum = 0.0, volume = 0.0, min_scaled_jacobian = 1.0;
+    int64_t inverted = 0, doublets = 0;
+    std::array<int64_t, 20> histogram{};
+    std::vector<int32_t> defects;  // ascending, at most the limit per kind
   };
-  double sum_scaled_jacobian = 0.0;
-  r.scaled_jacobian_histogram.assign(20, 0);
-  for (int32_t h = 0; h < mesh.hex_count(); ++h) {
-    const HexCorners p = hex_points(mesh, h);
-    const double sj = hex_scaled_jacobian(p);
-    sum_scaled_jacobian += sj;
-    r.min_scaled_jacobian = std::min(r.min_scaled_jacobian, sj);
-    r.volume += hex_volume(p);
-    ++r.scaled_jacobian_histogram[scaled_jacobian_bin(sj)];
-    if (sj <= 0.0) {
-      if (r.inverted_hexes == 0) r.first_inverted_hex = h;
-      ++r.inverted_hexes;
-      defect(h);
-    }
-  }
-  for (int32_t f : t.nonmanifold_faces) defect(t.face_hexes[f][0]);
-  if (r.hexes > 0) r.mean_scaled_jacobian = sum_scaled_jacobian / static_cast<double>(r.hexes);
-
-  // Doublets: a neighbour met across two local faces of the same hex.
-  for (int32_t h = 0; h < mesh.hex_count(); ++h) {
-    std::array<int32_t, 6> neighbours;
-    for (int lf = 0; lf < 6; ++lf) neighbours[lf] = hex_face_neighbor(t, h, lf);
-    for (int a = 0; a < 6; ++a) {
-      const int32_t g = neighbours[a];
-      if (g <= h) continue;  // count each pair once, from its lower hex
-      bool seen_before = false, repeated = false;
-      for (int b = 0; b < 6; ++b)
-        if (b != a && neighbours[b] == g) (b < a ? seen_before : repeated) = true;
-      if (repeated && !seen_before) {
-        ++r.doublets;
-        defect(h);
+  constexpr int64_t chunk_hexes = 1 << 14;
+  std::vector<ChunkSums> sums(static_cast<size_t>(parallel_chunk_count(r.hexes, chunk_hexes)));
+  parallel_chunks(threads, r.hexes, chunk_hexes, [&](int64_t chunk, int64_t begin, int64_t end) {
+    ChunkSums& s = sums[chunk];
+    size_t doublet_defects = 0;
+    for (int32_t h = static_cast<int32_t>(begin); h < end; ++h) {
+      const HexCorners p = hex_points(mesh, h);
+      const double sj = hex_scaled_jacobian(p);
+      s.scaled_jacobian_sum += sj;
+      s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
+      s.volume += hex_volume(p);
+      ++s.histogram[scaled_jacobian_bin(sj)];
+      if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
+        s.defects.push_back(h);
+      const std::array<int32_t, 6>& neighbours = adjacency.hex_neighbors[h];
+      for (int f = 0; f < 6; ++f) {
+        const int32_t g = neighbours[f];
+        if (g <= h) continue;  // count each pair once, from its lower hex
+        bool seen_before = false, repeated = false;
+        for (int e = 0; e < 6; ++e)
+          if (e != f && neighbours[e] == g) (e < f ? seen_before : repeated) = true;
+        if (repeated && !seen_before) {
+          ++s.doublets;
+          if (doublet_defects++ < mesh_check_defect_hex_limit) s.defects.push_back(h);
+        }
       }
     }
+  });
+  double sum_scaled_jacobian = 0.0;
+  r.scaled_jacobian_histogram.assign(20, 0);
+  for (const ChunkSums& s : sums) {
+    sum_scaled_jacobian += s.scaled_jacobian_sum;
+    r.volume += s.volume;
+    r.min_scaled_jacobian = std::min(r.min_scaled_jacobian, s.min_scaled_jacobian);
+    if (s.inverted > 0 && r.inverted_hexes == 0) r.first_inverted_hex = s.defects.front();
+    r.inverted_hexes += s.inverted;
+    r.doublets += s.doublets;
+    for (int b = 0; b < 20; ++b) r.scaled_jacobian_histogram[b] += s.histogram[b];
+    defects.insert(defects.end(), s.defects.begin(), s.defects.end());
   }
+  sums.clear();
+  if (r.hexes > 0) r.mean_scaled_jacobian = sum_scaled_jacobian / static_cast<double>(r.hexes);
+  std::vector<std::array<int32_t, 6>>().swap(adjacency.hex_neighbors);
 
   // Boundary surface: closedness and area.
-  const BoundarySurface surface = boundary_surface(mesh, t);
-  r.boundary_faces = static_cast<int64_t>(surface.faces.size());
+  const BoundarySurface surface = boundary_surface(mesh, std::move(adjacency.boundary_faces));
+  r.boundary_faces = static_cast<int64_t>(surface.slots.size());
   // Every boundary edge must be used by exactly two boundary faces: count the uses of each
   // (lower node, higher node) pair over the boundary faces (sorted, linear in the boundary).
   std::vector<uint64_t> boundary_edges;
-  boundary_edges.reserve(4 * surface.faces.size());
-  for (size_t i = 0; i < surface.faces.size(); ++i) {
+  boundary_edges.reserve(4 * surface.slots.size());
+  for (size_t i = 0; i < surface.slots.size(); ++i) {
     const auto& n = surface.nodes[i];
     for (int k = 0; k < 4; ++k) {
       const uint32_t a = static_cast<uint32_t>(n[k]), b = static_cast<uint32_t>(n[(k + 1) % 4]);
@@ -307,8 +335,8 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
   // lying on another boundary face of this mesh.
   std::vector<int32_t> non_conformal;  // indices into surface
   if (reference) {
-    const HexTopology reference_topology = topology_build(*reference, TopologyParts::faces);
-    const BoundarySurface reference_surface = boundary_surface(*reference, reference_topology);
+    const BoundarySurface reference_surface =
+        boundary_surface(*reference, hex_face_adjacency_build(*reference, threads).boundary_faces);
     const QuadGrid grid(reference_surface.quads, reference_surface.tolerances);
     for (size_t i = 0; i < surface.quads.size(); ++i) {
       const Quad& q = surface.quads[i];
@@ -343,7 +371,7 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference) {
     }
   }
   r.non_conformal_faces = static_cast<int64_t>(non_conformal.size());
-  for (int32_t i : non_conformal) defect(t.face_hexes[surface.faces[i]][0]);
+  for (int32_t i : non_conformal) defects.push_back(surface.slots[i].hex);
   std::sort(defects.begin(), defects.end());
   defects.erase(std::unique(defects.begin(), defects.end()), defects.end());
   if (defects.size() > mesh_check_defect_hex_limit) defects.resize(mesh_check_defect_hex_limit);

@@ -38,8 +38,9 @@
 /// the reference is planar (out-of-plane spread <= 1e-12 x its diagonal), refinement must preserve
 /// both to mesh_check_geometry_tolerance relative; otherwise the errors are only reported.
 ///
-/// Time: linear in the mesh size (topology_build, hash grids over boundary faces); duplicate nodes
-/// by one sort of the quantised positions (n log n).
+/// Time: linear in the mesh size: faces matched by hex_face_adjacency_build (no general
+/// topology), hash grids over the boundary faces, duplicate nodes by a counting sort of the
+/// points into cells. Memory: about 60 bytes per hex of the checked mesh at its peak.
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -98,9 +99,11 @@ struct MeshCheckReport {
 /// How many defect hexes a report lists.
 inline constexpr size_t mesh_check_defect_hex_limit = 20;
 
-/// Checks `mesh` (and compares it with `reference`, the mesh before refinement, if given).
-/// Throws InputError naming the hex if a node id is out of range or repeated within a hex.
-MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference = nullptr);
+/// Checks `mesh` (and compares it with `reference`, the mesh before refinement, if given), on up
+/// to `threads` threads; the report is the same for every thread count. Throws InputError naming
+/// the hex if a node id is out of range or repeated within a hex.
+MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference = nullptr,
+                           int threads = 1);
 
 /// All fields of the report under their own names, plus "valid" (the reference fields only when
 /// reference_compared).

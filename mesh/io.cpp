@@ -10,8 +10,9 @@
 #include <fstream>
 
 #include "mesh/error.hpp"
+#include "mesh/hex_convention.hpp"
+#include "mesh/hex_face_adjacency.hpp"
 #include "mesh/io_text.hpp"
-#include "mesh/topology.hpp"
 
 namespace hexrefine {
 
@@ -89,13 +90,15 @@ std::vector<int32_t> id_permutation_slots(const std::vector<int64_t>& ids) {
 
 void mesh_check_read(const HexMesh& mesh, const std::string& path) {
   mesh_validate_ids(mesh, path);
-  const HexTopology t = topology_build(mesh, TopologyParts::faces);
-  if (!t.nonmanifold_faces.empty()) {
-    const auto& f = t.face_nodes[t.nonmanifold_faces[0]];
-    throw InputError(path + ": non-manifold mesh: face with nodes " + std::to_string(f[0]) + " " +
-                     std::to_string(f[1]) + " " + std::to_string(f[2]) + " " +
-                     std::to_string(f[3]) + " (0-based) is shared by more than two hexes (" +
-                     std::to_string(t.nonmanifold_faces.size()) + " such faces)");
+  const HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh);
+  if (!adjacency.nonmanifold_faces.empty()) {
+    const HexFaceSlot& slot = adjacency.nonmanifold_faces[0];
+    const HexCell& c = mesh.hexes[slot.hex];
+    const int* fv = hex_faces[slot.local_face];
+    throw InputError(path + ": non-manifold mesh: face with nodes " + std::to_string(c[fv[0]]) +
+                     " " + std::to_string(c[fv[1]]) + " " + std::to_string(c[fv[2]]) + " " +
+                     std::to_string(c[fv[3]]) + " (0-based) is shared by more than two hexes (" +
+                     std::to_string(adjacency.nonmanifold_faces.size()) + " such faces)");
   }
 }
 

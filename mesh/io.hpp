@@ -25,7 +25,8 @@
 ///   field. On reading, block_id comes from the physical tag (0 without one) and is overridden by
 ///   an $ElementData field of that name; every single-component $ElementData field whose values
 ///   are all integers becomes an attribute.
-/// - Exodus II: one element block per block_id (id 1 when the mesh has no block_id). Hexes keep
+/// - Exodus II: written in netCDF classic storage, read in classic and netCDF-4 (HDF5) storage.
+///   One element block per block_id (id 1 when the mesh has no block_id). Hexes keep
 ///   their order through the element id map (written as hex index + 1; when a file's element ids
 ///   are a permutation of 1..n the reader orders hexes by id). Every other attribute (parent_hex,
 ///   template_tag, ...) and every cell scalar is an element variable at one time step; on

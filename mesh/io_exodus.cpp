@@ -28,6 +28,10 @@ namespace hexrefine::io_detail {
 
 namespace {
 
+/// Entries per chunk of the bulk arrays (coordinates, connectivity, maps, variables) in both
+/// directions: buffers of a few tens of MB, reused, instead of whole-mesh copies.
+constexpr size_t exodus_chunk = size_t{1} << 20;
+
 /// Closes the Exodus file on every path out.
 struct ExodusFile {
   int id = -1;
@@ -449,17 +453,22 @@ HexMesh exodus_read(const std::string& path) {
                      " bytes) can hold");
   HexMesh mesh;
   {
-    std::vector<double> x(nodes), y(nodes), z(nodes);
-    if (nodes > 0 && ex_get_coord(file.id, x.data(), y.data(), z.data()) < 0)
-      throw InputError(path + ": cannot read the node coordinates");
+    std::vector<double> x, y, z;
     mesh.points.resize(nodes);
-    for (int64_t i = 0; i < nodes; ++i) {
-      mesh.points[i] = Eigen::Vector3d(x[i], y[i], z[i]);
-      // netCDF returns its fill value for data missing from a truncated file.
-      if (!mesh.points[i].allFinite() || (mesh.points[i].array() == 9.9692099683868690e+36).any())
-        throw InputError(path + ": node " + std::to_string(i + 1) +
-                         " has a NaN, infinite or unwritten (netCDF fill) coordinate: corrupt or "
-                         "truncated file");
+    for (int64_t begin = 0; begin < nodes; begin += static_cast<int64_t>(exodus_chunk)) {
+      const int64_t count = std::min<int64_t>(nodes - begin, exodus_chunk);
+      x.resize(count), y.resize(count), z.resize(count);
+      if (ex_get_partial_coord(file.id, begin + 1, count, x.data(), y.data(), z.data()) < 0)
+        throw InputError(path + ": cannot read the node coordinates");
+      for (int64_t k = 0; k < count; ++k) {
+        const int64_t i = begin + k;
+        mesh.points[i] = Eigen::Vector3d(x[k], y[k], z[k]);
+        // netCDF returns its fill value for data missing from a truncated file.
+        if (!mesh.points[i].allFinite() || (mesh.points[i].array() == 9.9692099683868690e+36).any())
+          throw InputError(path + ": node " + std::to_string(i + 1) +
+                           " has a NaN, infinite or unwritten (netCDF fill) coordinate: corrupt "
+                           "or truncated file");
+      }
     }
   }
   std::vector<int64_t> block_ids(blocks);
@@ -476,6 +485,9 @@ HexMesh exodus_read(const std::string& path) {
                        "(corrupt or truncated file)");
   std::vector<int64_t> hex_ids;
   std::vector<int32_t> block;
+  mesh.hexes.reserve(elems);
+  hex_ids.reserve(elems);
+  block.reserve(elems);
   std::vector<std::pair<int64_t, int64_t>> hex_blocks;  // (file-order block index, hex count)
   int64_t first_element = 0;
   for (int64_t b = 0; b < blocks; ++b) {
@@ -511,21 +523,26 @@ HexMesh exodus_read(const std::string& path) {
       }
       if (block_id < INT32_MIN || block_id > INT32_MAX)
         throw InputError(where + ": block id out of the int32 range");
-      std::vector<int64_t> conn(count * 8);
-      if (ex_get_conn(file.id, EX_ELEM_BLOCK, bid, conn.data(), nullptr, nullptr) < 0)
-        throw InputError(where + ": cannot read its connectivity");
-      for (int64_t e = 0; e < count; ++e) {
-        HexCell c;
-        for (int k = 0; k < 8; ++k) {
-          const int64_t v = conn[e * 8 + k];
-          if (v < 1 || v > nodes)
-            throw InputError(where + ", element " + std::to_string(e + 1) + ": node " +
-                             std::to_string(v) + " out of range 1.." + std::to_string(nodes));
-          c[k] = static_cast<int32_t>(v - 1);
+      std::vector<int64_t> conn;
+      for (int64_t begin = 0; begin < count; begin += static_cast<int64_t>(exodus_chunk)) {
+        const int64_t chunk = std::min<int64_t>(count - begin, exodus_chunk);
+        conn.resize(chunk * 8);
+        if (ex_get_partial_conn(file.id, EX_ELEM_BLOCK, bid, begin + 1, chunk, conn.data(), nullptr,
+                                nullptr) < 0)
+          throw InputError(where + ": cannot read its connectivity");
+        for (int64_t e = 0; e < chunk; ++e) {
+          HexCell c;
+          for (int k = 0; k < 8; ++k) {
+            const int64_t v = conn[e * 8 + k];
+            if (v < 1 || v > nodes)
+              throw InputError(where + ", element " + std::to_string(begin + e + 1) + ": node " +
+                               std::to_string(v) + " out of range 1.." + std::to_string(nodes));
+            c[k] = static_cast<int32_t>(v - 1);
+          }
+          mesh.hexes.push_back(c);
+          block.push_back(static_cast<int32_t>(block_id));
+          hex_ids.push_back(element_map[first_element + begin + e]);
         }
-        mesh.hexes.push_back(c);
-        block.push_back(static_cast<int32_t>(block_id));
-        hex_ids.push_back(element_map[first_element + e]);
       }
       hex_blocks.push_back({b, count});
     }
@@ -544,8 +561,11 @@ HexMesh exodus_read(const std::string& path) {
       seen[t - 1] = 1, slot[i] = static_cast<int32_t>(t - 1);
   }
   mesh.attributes.push_back({std::string(attribute_block_id), std::move(block)});
-  for (HexAttribute& a : exodus_element_variables(path, hex_blocks)) mesh.attributes.push_back(a);
-  if (permutation) {
+  for (HexAttribute& a : exodus_element_variables(path, hex_blocks))
+    mesh.attributes.push_back(std::move(a));
+  bool identity = permutation;
+  for (size_t i = 0; i < m && identity; ++i) identity = slot[i] == static_cast<int32_t>(i);
+  if (permutation && !identity) {
     std::vector<HexCell> hexes(m);
     for (size_t i = 0; i < m; ++i) hexes[slot[i]] = mesh.hexes[i];
     mesh.hexes = std::move(hexes);
@@ -583,75 +603,128 @@ void exodus_write(const std::string& path, const HexMesh& mesh,
   {
     int comp_ws = 8, io_ws = 8;
     ExodusFile file;
+    // Classic netCDF storage, although netCDF-4 (HDF5) writes 3 s where classic writes 6 s for
+    // the 960 MB of an 11.4 M-hex mesh (classic's 8 KB buffer reads and rewrites each block):
+    // a truncated or corrupted HDF5 file can crash the HDF5 library inside the reader, where the
+    // classic header is checked before the library sees it (netcdf_classic_header_check).
     file.id = ex_create(tmp.c_str(), EX_CLOBBER | EX_ALL_INT64_API, &comp_ws, &io_ws);
     if (file.id < 0) failed("cannot create (folder missing or not writable)");
+    // Every value below is written, so netCDF's pre-fill of each variable would write the file
+    // twice.
+    int previous_fill = 0;
+    if (nc_set_fill(file.id, NC_NOFILL, &previous_fill) != NC_NOERR) failed("fill mode");
+    // Definitions first, data after: in a classic netCDF file every definition that grows the
+    // header moves all data written before it (writing bulk data between definitions rewrote
+    // the file two to three times).
     if (ex_put_init(file.id, "hexrefine mesh", 3, static_cast<int64_t>(n), static_cast<int64_t>(m),
                     static_cast<int64_t>(blocks.size()), 0, 0) < 0)
       failed("header");
-    std::vector<double> x(n), y(n), z(n);
-    for (size_t i = 0; i < n; ++i)
-      x[i] = mesh.points[i].x(), y[i] = mesh.points[i].y(), z[i] = mesh.points[i].z();
-    if (n > 0 && ex_put_coord(file.id, x.data(), y.data(), z.data()) < 0) failed("coordinates");
     char cx[] = "x", cy[] = "y", cz[] = "z";
-    char* names[] = {cx, cy, cz};
-    if (ex_put_coord_names(file.id, names) < 0) failed("coordinate names");
-    size_t i = 0;
-    std::vector<int64_t> map(m);
-    for (size_t bi = 0; bi < blocks.size(); ++bi) {
+    char* coordinate_names[] = {cx, cy, cz};
+    if (ex_put_coord_names(file.id, coordinate_names) < 0) failed("coordinate names");
+    std::vector<size_t> block_first(blocks.size() + 1, 0);  // hexes of block bi: order[first..)
+    for (size_t bi = 0, i = 0; bi < blocks.size(); ++bi) {
       const int64_t b = blocks[bi], eid = exodus_ids[bi];
-      const size_t first = i;
-      std::vector<int64_t> conn;
-      for (; i < m && order[i].first == b; ++i) {
-        for (int32_t v : mesh.hexes[order[i].second]) conn.push_back(v + 1);
-        map[i] = order[i].second + 1;
-      }
-      if (ex_put_block(file.id, EX_ELEM_BLOCK, eid, "HEX8", static_cast<int64_t>(i - first), 8, 0,
-                       0, 0) < 0)
+      block_first[bi] = i;
+      while (i < m && order[i].first == b) ++i;
+      block_first[bi + 1] = i;
+      if (ex_put_block(file.id, EX_ELEM_BLOCK, eid, "HEX8",
+                       static_cast<int64_t>(i - block_first[bi]), 8, 0, 0, 0) < 0)
         failed("element block " + std::to_string(b));
-      if (ex_put_conn(file.id, EX_ELEM_BLOCK, eid, conn.data(), nullptr, nullptr) < 0)
-        failed("connectivity of element block " + std::to_string(b));
       if (b <= 0) {
         const std::string name = "hexrefine_block_id=" + std::to_string(b);
         if (ex_put_name(file.id, EX_ELEM_BLOCK, eid, name.c_str()) < 0)
           failed("name of element block " + std::to_string(b));
       }
     }
-    if (m > 0 && ex_put_id_map(file.id, EX_ELEM_MAP, map.data()) < 0) failed("element id map");
     // Element variables (one time step): every attribute but block_id (the blocks hold it),
-    // then the cell scalars, by block in the order written above.
-    std::vector<std::pair<std::string, std::vector<double>>> fields;
+    // then the cell scalars, by block in the order of the blocks.
+    struct Field {
+      std::string name;
+      const std::vector<int32_t>* integers;
+      const std::vector<double>* reals;
+      double operator[](size_t h) const { return integers ? (*integers)[h] : (*reals)[h]; }
+    };
+    std::vector<Field> fields;
     for (const HexAttribute& a : mesh.attributes)
-      if (a.name != attribute_block_id)
-        fields.push_back({a.name, std::vector<double>(a.values.begin(), a.values.end())});
-    for (const auto& s : cell_scalars) fields.push_back(s);
-    if (m > 0 && !fields.empty()) {
+      if (a.name != attribute_block_id) fields.push_back({a.name, &a.values, nullptr});
+    for (const auto& s : cell_scalars) fields.push_back({s.first, nullptr, &s.second});
+    if (m == 0) fields.clear();
+    if (!fields.empty()) {
       size_t longest = 0;
-      for (const auto& f : fields) longest = std::max(longest, f.first.size());
+      for (const Field& f : fields) longest = std::max(longest, f.name.size());
       if (longest > 32 && ex_set_max_name_length(file.id, static_cast<int>(longest)) < 0)
         failed("variable name length");
       if (ex_put_variable_param(file.id, EX_ELEM_BLOCK, static_cast<int>(fields.size())) < 0)
         failed("element variable count");
       std::vector<char*> names;
-      for (auto& f : fields) names.push_back(f.first.data());
+      for (Field& f : fields) names.push_back(f.name.data());
       if (ex_put_variable_names(file.id, EX_ELEM_BLOCK, static_cast<int>(fields.size()),
                                 names.data()) < 0)
         failed("element variable names");
+      // The truth table defines every block's variables now rather than at their first write.
+      std::vector<int> truth(blocks.size() * fields.size(), 1);
+      if (ex_put_truth_table(file.id, EX_ELEM_BLOCK, static_cast<int>(blocks.size()),
+                             static_cast<int>(fields.size()), truth.data()) < 0)
+        failed("element variable truth table");
+    }
+    // The element id map is defined at its first write: written before the other bulk data.
+    // Bulk data goes out in chunks through reused buffers: one buffer per array of the whole
+    // mesh would fault in about as much fresh memory as the mesh holds.
+    std::vector<int64_t> map;
+    for (size_t begin = 0; begin < m; begin += exodus_chunk) {
+      const size_t end = std::min(m, begin + exodus_chunk);
+      map.clear();
+      for (size_t k = begin; k < end; ++k) map.push_back(order[k].second + 1);
+      if (ex_put_partial_id_map(file.id, EX_ELEM_MAP, static_cast<int64_t>(begin + 1),
+                                static_cast<int64_t>(end - begin), map.data()) < 0)
+        failed("element id map");
+    }
+    if (!fields.empty()) {
       const double time = 0.0;
       if (ex_put_time(file.id, 1, &time) < 0) failed("time step");
-      std::vector<double> values;
-      size_t at = 0;
-      for (size_t bi = 0; bi < blocks.size(); ++bi) {
-        const size_t first = at;
-        while (at < m && order[at].first == blocks[bi]) ++at;
-        for (size_t f = 0; f < fields.size(); ++f) {
-          values.clear();
-          for (size_t k = first; k < at; ++k) values.push_back(fields[f].second[order[k].second]);
-          if (ex_put_var(file.id, 1, EX_ELEM_BLOCK, static_cast<int>(f + 1), exodus_ids[bi],
-                         static_cast<int64_t>(values.size()), values.data()) < 0)
-            failed("element variable " + fields[f].first);
-        }
+    }
+    std::vector<double> x, y, z;
+    for (size_t begin = 0; begin < n; begin += exodus_chunk) {
+      const size_t end = std::min(n, begin + exodus_chunk);
+      x.resize(end - begin), y.resize(end - begin), z.resize(end - begin);
+      for (size_t i = begin; i < end; ++i)
+        x[i - begin] = mesh.points[i].x(), y[i - begin] = mesh.points[i].y(),
+              z[i - begin] = mesh.points[i].z();
+      if (ex_put_partial_coord(file.id, static_cast<int64_t>(begin + 1),
+                               static_cast<int64_t>(end - begin), x.data(), y.data(), z.data()) < 0)
+        failed("coordinates");
+    }
+    std::vector<int32_t> conn;
+    for (size_t bi = 0; bi < blocks.size(); ++bi) {
+      const int64_t b = blocks[bi];
+      // The library has no partial connectivity writer: its variable (connect<block index>,
+      // 1-based in file order) is written through netCDF, chunk by chunk.
+      int conn_id = -1;
+      if (nc_inq_varid(file.id, ("connect" + std::to_string(bi + 1)).c_str(), &conn_id) != NC_NOERR)
+        failed("connectivity variable of element block " + std::to_string(b));
+      for (size_t begin = block_first[bi]; begin < block_first[bi + 1]; begin += exodus_chunk) {
+        const size_t end = std::min(block_first[bi + 1], begin + exodus_chunk);
+        conn.clear();
+        for (size_t k = begin; k < end; ++k)
+          for (int32_t v : mesh.hexes[order[k].second]) conn.push_back(v + 1);
+        const size_t start[2] = {begin - block_first[bi], 0}, count[2] = {end - begin, 8};
+        if (nc_put_vara_int(file.id, conn_id, start, count, conn.data()) != NC_NOERR)
+          failed("connectivity of element block " + std::to_string(b));
       }
     }
+    std::vector<double> values;
+    for (size_t bi = 0; bi < blocks.size(); ++bi)
+      for (size_t f = 0; f < fields.size(); ++f)
+        for (size_t begin = block_first[bi]; begin < block_first[bi + 1]; begin += exodus_chunk) {
+          const size_t end = std::min(block_first[bi + 1], begin + exodus_chunk);
+          values.clear();
+          for (size_t k = begin; k < end; ++k) values.push_back(fields[f][order[k].second]);
+          if (ex_put_partial_var(file.id, 1, EX_ELEM_BLOCK, static_cast<int>(f + 1), exodus_ids[bi],
+                                 static_cast<int64_t>(begin - block_first[bi] + 1),
+                                 static_cast<int64_t>(end - begin), values.data()) < 0)
+            failed("element variable " + fields[f].name);
+        }
     const int id = file.id;
     file.id = -1;
     if (ex_close(id) < 0) failed("close (disk full?)");

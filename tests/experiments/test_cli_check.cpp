@@ -43,7 +43,8 @@ TEST(CliCheck, SharedMeshes) {
   for (const SharedMeshCase& c : shared_cases) {
     SCOPED_TRACE(c.file);
     const auto report = dir / (std::string(c.file) + ".json");
-    const CliRun run = cli_run("check " + shared_mesh(c.file) + " --report " + report.string());
+    const CliRun run =
+        cli_run("check " + shared_mesh(c.file) + " --sheets --report " + report.string());
     const bool valid = c.conformal && c.inverted == 0;
     EXPECT_EQ(run.exit_code, valid ? 0 : 1) << run.output;
     ASSERT_TRUE(std::filesystem::exists(report)) << run.output;  // written even on exit 1
@@ -125,8 +126,8 @@ TEST(CliCheck, RefinedBrickAgainstReference) {
   mesh_write(reference, fixture_brick(2, 2, 2));
   mesh_write(refined, fixture_brick(4, 4, 4, 0.5));
   const auto report = dir / "r.json";
-  const CliRun run =
-      cli_run("check " + refined + " --reference " + reference + " --report " + report.string());
+  const CliRun run = cli_run("check " + refined + " --reference " + reference +
+                             " --sheets --report " + report.string());
   EXPECT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = read_json(report);
   EXPECT_EQ(j["hexes"], 64);
@@ -139,6 +140,25 @@ TEST(CliCheck, RefinedBrickAgainstReference) {
   EXPECT_EQ(j["sheets"], 12);  // 4 layers per axis
   EXPECT_EQ(j["self_intersecting_sheets"], 0);
   EXPECT_EQ(j["boundary_faces"], 96);
+}
+
+TEST(CliCheck, SheetsOnlyOnRequestAndThreadsGiveTheSameReport) {
+  const auto dir = test_temp_dir("cli_check_threads");
+  const std::string mesh = shared_mesh("rockerarm.mesh");
+  nlohmann::json reports[2];
+  for (int threads = 1; threads <= 2; ++threads) {
+    const auto report = dir / ("r" + std::to_string(threads) + ".json");
+    const CliRun run = cli_run("check " + mesh + " --threads " + std::to_string(threads) +
+                               " --verbose --report " + report.string());
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("hexrefine: check "), std::string::npos) << run.output;
+    reports[threads - 1] = read_json(report);
+    EXPECT_FALSE(reports[threads - 1].contains("sheets"));
+    EXPECT_TRUE(reports[threads - 1]["stage_seconds"].contains("read"));
+    reports[threads - 1].erase("stage_seconds");
+  }
+  EXPECT_EQ(reports[0], reports[1]);
+  EXPECT_EQ(reports[0]["hexes"], 10600);
 }
 
 TEST(CliCheck, OctreeSplitBesideUnsplitHex) {

@@ -1,0 +1,125 @@
+#include "mesh/hex_face_adjacency.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "mesh/error.hpp"
+#include "mesh/hex_convention.hpp"
+#include "mesh/parallel.hpp"
+
+namespace hexrefine {
+
+namespace {
+
+int32_t face_lowest_node(const HexCell& c, int lf) {
+  const int* fv = hex_faces[lf];
+  return std::min(std::min(c[fv[0]], c[fv[1]]), std::min(c[fv[2]], c[fv[3]]));
+}
+
+/// The three nodes of local face lf other than its lowest, ascending: with the lowest node (the
+/// bucket) they identify the face's node set.
+std::array<int32_t, 3> face_other_nodes(const HexCell& c, int lf, int32_t lowest) {
+  const int* fv = hex_faces[lf];
+  std::array<int32_t, 3> o{};
+  int k = 0;
+  for (int i = 0; i < 4; ++i)
+    if (c[fv[i]] != lowest) o[k++] = c[fv[i]];
+  // A three-element sorting network: no call, no loop.
+  if (o[0] > o[1]) std::swap(o[0], o[1]);
+  if (o[1] > o[2]) std::swap(o[1], o[2]);
+  if (o[0] > o[1]) std::swap(o[0], o[1]);
+  return o;
+}
+
+}  // namespace
+
+HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads) {
+  const int32_t hexes = mesh.hex_count();
+  if (hexes > hex_face_adjacency_max_hexes)
+    throw OperationError("the mesh has " + std::to_string(hexes) +
+                         " hexes; face matching handles at most " +
+                         std::to_string(hex_face_adjacency_max_hexes));
+  const int32_t nodes = mesh.point_count();
+
+  // Counting sort of the slots by lowest node: bucket_end[a] first counts, then holds where
+  // node a's bucket starts, and after the fill where it ends (no separate cursor array).
+  std::vector<uint32_t> bucket_end(static_cast<size_t>(nodes), 0);
+  for (const HexCell& c : mesh.hexes)
+    for (int lf = 0; lf < 6; ++lf) ++bucket_end[face_lowest_node(c, lf)];
+  uint32_t running = 0;
+  for (uint32_t& b : bucket_end) {
+    const uint32_t count = b;
+    b = running;
+    running += count;
+  }
+  std::vector<uint32_t> slots(running);
+  for (int32_t h = 0; h < hexes; ++h)
+    for (int lf = 0; lf < 6; ++lf)
+      slots[bucket_end[face_lowest_node(mesh.hexes[h], lf)]++] = static_cast<uint32_t>(h) * 6 + lf;
+
+  HexFaceAdjacency a;
+  a.hex_neighbors.resize(static_cast<size_t>(hexes));
+  // Node ranges are matched independently; their boundary and non-manifold faces are
+  // concatenated in range order, which is the sequential order.
+  constexpr int64_t chunk_nodes = 1 << 15;
+  constexpr int64_t prefetch_distance = 4;
+  const int64_t chunks = parallel_chunk_count(nodes, chunk_nodes);
+  std::vector<std::vector<HexFaceSlot>> boundary(static_cast<size_t>(chunks));
+  std::vector<std::vector<HexFaceSlot>> nonmanifold(static_cast<size_t>(chunks));
+  parallel_chunks(threads, nodes, chunk_nodes, [&](int64_t chunk, int64_t begin, int64_t end) {
+    struct SlotKey {
+      std::array<int32_t, 3> others;
+      uint32_t slot;
+      bool matched;
+    };
+    std::vector<SlotKey> keys;
+    for (int64_t node = begin; node < end; ++node) {
+      const uint32_t first = node == 0 ? 0 : bucket_end[node - 1];
+      // The hexes of a bucket are scattered over the mesh: fetching those of a bucket a few
+      // nodes ahead hides most of the cache misses.
+      if (node + prefetch_distance < end)
+        for (uint32_t k = bucket_end[node + prefetch_distance - 1];
+             k < bucket_end[node + prefetch_distance]; ++k) {
+          __builtin_prefetch(&mesh.hexes[slots[k] / 6]);
+          __builtin_prefetch(&a.hex_neighbors[slots[k] / 6], 1);
+        }
+      keys.clear();
+      for (uint32_t k = first; k < bucket_end[node]; ++k) {
+        const uint32_t s = slots[k];
+        keys.push_back({face_other_nodes(mesh.hexes[s / 6], static_cast<int>(s % 6),
+                                         static_cast<int32_t>(node)),
+                        s, false});
+      }
+      // Buckets hold a handful of slots (6 on average), so a quadratic match beats sorting and
+      // keeps the slots, hence the faces, in ascending order.
+      for (size_t i = 0; i < keys.size(); ++i) {
+        if (keys[i].matched) continue;
+        const int32_t h0 = static_cast<int32_t>(keys[i].slot / 6);
+        int32_t h1 = -1, users = 1;
+        for (size_t j = i + 1; j < keys.size(); ++j) {
+          if (keys[j].matched || keys[j].others[0] != keys[i].others[0] ||
+              keys[j].others[1] != keys[i].others[1] || keys[j].others[2] != keys[i].others[2])
+            continue;
+          keys[j].matched = true;
+          const int32_t h = static_cast<int32_t>(keys[j].slot / 6);
+          a.hex_neighbors[h][keys[j].slot % 6] = h0;
+          if (++users == 2) h1 = h;
+        }
+        a.hex_neighbors[h0][keys[i].slot % 6] = h1;
+        if (users == 1)
+          boundary[chunk].push_back({h0, static_cast<int32_t>(keys[i].slot % 6)});
+        else if (users > 2)
+          nonmanifold[chunk].push_back({h0, static_cast<int32_t>(keys[i].slot % 6)});
+      }
+    }
+  });
+  std::vector<uint32_t>().swap(slots);
+  for (int64_t c = 0; c < chunks; ++c) {
+    a.boundary_faces.insert(a.boundary_faces.end(), boundary[c].begin(), boundary[c].end());
+    a.nonmanifold_faces.insert(a.nonmanifold_faces.end(), nonmanifold[c].begin(),
+                               nonmanifold[c].end());
+  }
+  return a;
+}
+
+}  // namespace hexrefine

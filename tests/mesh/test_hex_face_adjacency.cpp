@@ -1,0 +1,81 @@
+#include "mesh/hex_face_adjacency.hpp"
+
+#include <gtest/gtest.h>
+
+#include "mesh/io.hpp"
+#include "mesh/topology.hpp"
+#include "tests/cli_runner.hpp"
+#include "tests/fixtures.hpp"
+
+namespace hexrefine {
+namespace {
+
+/// The adjacency must say what topology_build says: the same neighbour across every local face,
+/// the same boundary faces in the same order, the same non-manifold faces.
+void expect_same_as_topology(const HexMesh& m, const HexFaceAdjacency& a) {
+  const HexTopology t = topology_build(m, TopologyParts::faces);
+  ASSERT_EQ(a.hex_neighbors.size(), m.hexes.size());
+  for (int32_t h = 0; h < m.hex_count(); ++h)
+    for (int lf = 0; lf < 6; ++lf)
+      ASSERT_EQ(a.hex_neighbors[h][lf], hex_face_neighbor(t, h, lf)) << "hex " << h << " " << lf;
+  const std::vector<int32_t> boundary = topology_boundary_faces(t);
+  ASSERT_EQ(a.boundary_faces.size(), boundary.size());
+  for (size_t i = 0; i < boundary.size(); ++i) {
+    const HexFaceSlot& s = a.boundary_faces[i];
+    EXPECT_EQ(t.hex_face_ids[s.hex][s.local_face], boundary[i]) << i;
+  }
+  ASSERT_EQ(a.nonmanifold_faces.size(), t.nonmanifold_faces.size());
+  for (size_t i = 0; i < a.nonmanifold_faces.size(); ++i) {
+    const HexFaceSlot& s = a.nonmanifold_faces[i];
+    EXPECT_EQ(t.hex_face_ids[s.hex][s.local_face], t.nonmanifold_faces[i]);
+    EXPECT_EQ(t.face_hexes[t.nonmanifold_faces[i]][0], s.hex);  // the lowest user
+  }
+}
+
+TEST(HexFaceAdjacency, BrickCounts) {
+  const int nx = 3, ny = 4, nz = 5;
+  const HexMesh m = fixture_brick(nx, ny, nz);
+  const HexFaceAdjacency a = hex_face_adjacency_build(m);
+  EXPECT_EQ(static_cast<int>(a.boundary_faces.size()), 2 * (nx * ny + ny * nz + nx * nz));
+  EXPECT_TRUE(a.nonmanifold_faces.empty());
+  // The hex at (1, 1, 1) has the six neighbours one step along each axis.
+  const int32_t h = fixture_brick_hex(nx, ny, 1, 1, 1);
+  int neighbours = 0;
+  for (int32_t g : a.hex_neighbors[h]) neighbours += g >= 0;
+  EXPECT_EQ(neighbours, 6);
+  expect_same_as_topology(m, a);
+}
+
+TEST(HexFaceAdjacency, NonManifoldFaceGoesToItsLowestHex) {
+  HexMesh m = fixture_brick(1, 1, 2);  // two hexes stacked in z
+  const HexCell c = m.hexes[0];
+  m.hexes.push_back({c[4], c[5], c[6], c[7], c[0], c[1], c[2], c[3]});  // a third on the face
+  const HexFaceAdjacency a = hex_face_adjacency_build(m);
+  ASSERT_EQ(a.nonmanifold_faces.size(), 1u);
+  EXPECT_EQ(a.nonmanifold_faces[0].hex, 0);
+  // Hex 2 has hex 0's eight nodes: five faces pair it with hex 0, and on the face hexes 0, 1 and
+  // 2 share, the third user points to the lowest: all six give hex 0.
+  int to_hex0 = 0;
+  for (int32_t g : a.hex_neighbors[2]) to_hex0 += g == 0;
+  EXPECT_EQ(to_hex0, 6);
+  expect_same_as_topology(m, a);
+}
+
+TEST(HexFaceAdjacency, SharedMeshesMatchTopologyOnAnyThreadCount) {
+  for (const char* name : {"rockerarm.mesh", "ellipsoid.mesh", "sphere_conforming.mesh"}) {
+    SCOPED_TRACE(name);
+    const HexMesh m = mesh_read(shared_mesh(name));
+    const HexFaceAdjacency one = hex_face_adjacency_build(m, 1);
+    expect_same_as_topology(m, one);
+    const HexFaceAdjacency two = hex_face_adjacency_build(m, 2);
+    EXPECT_EQ(two.hex_neighbors, one.hex_neighbors);
+    ASSERT_EQ(two.boundary_faces.size(), one.boundary_faces.size());
+    for (size_t i = 0; i < one.boundary_faces.size(); ++i) {
+      EXPECT_EQ(two.boundary_faces[i].hex, one.boundary_faces[i].hex);
+      EXPECT_EQ(two.boundary_faces[i].local_face, one.boundary_faces[i].local_face);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hexrefine

@@ -15,7 +15,13 @@
 ///   median, the median of the plain entries (a single entry: itself). Times are converted to
 ///   seconds by their "time_unit" before the ratio NEW/BASE. The flag follows cpu_time by default
 ///   (`--by real` for real_time): "slower" when the ratio exceeds 1 + threshold, "faster" when it
-///   is below 1 - threshold. Benchmarks with an error are listed as errors, not compared.
+///   is below 1 - threshold, and, when both files hold >= 3 repetitions of it, the one-sided
+///   Mann-Whitney U test (bench_statistics.hpp) finds the repetitions differ at 5 %; otherwise
+///   "within spread". Without repetitions there is no spread to test: the ratio alone flags, as
+///   "slower?" / "faster?". Benchmarks with an error are listed as errors, not compared.
+/// - `bench --history FILE.jsonl` appends one line per run: commit (git, of the current folder),
+///   date, machine, and per benchmark the median, minimum and maximum real and CPU seconds and
+///   the number of repetitions; results/bench/plot_history.py draws it.
 /// - Exit codes: bench-compare returns 0 whatever the ratios (a comparison is information, not a
 ///   verdict) and 2 for unreadable or malformed input; bench returns 1 if an executable fails.
 /// - Google Benchmark prints NaN (not JSON) for undefined statistics such as the coefficient of
@@ -29,16 +35,19 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "experiments/bench_statistics.hpp"
 #include "experiments/cli.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
@@ -99,10 +108,12 @@ std::string run_capturing(const std::string& command, const std::string& what) {
   return output;
 }
 
-/// One benchmark's times in seconds as compared (median aggregate or median of the entries).
+/// One benchmark's times in seconds as compared (median aggregate or median of the entries), and
+/// the repetitions' own times (empty when the file holds aggregates only).
 struct BenchTimes {
   double real_seconds = 0.0;
   double cpu_seconds = 0.0;
+  std::vector<double> real_samples, cpu_samples;
   bool error = false;
   std::string error_message;
 };
@@ -239,6 +250,8 @@ std::map<std::string, BenchTimes> bench_read(const std::string& path) {
     }
     if (c.error) t.error = true;
     t.error_message = c.error_message;
+    t.real_samples = c.real;
+    t.cpu_samples = c.cpu;
     out.emplace(name, t);
   }
   return out;
@@ -255,6 +268,70 @@ std::string seconds_text(double seconds) {
   std::ostringstream s;
   s << std::setprecision(4) << seconds << " s";
   return s.str();
+}
+
+/// The first line of `command`'s output, or "unknown" if it fails (no git, not a checkout).
+std::string first_line_or_unknown(const std::string& command) {
+  FILE* pipe = popen((command + " 2>/dev/null").c_str(), "r");
+  if (!pipe) return "unknown";
+  std::array<char, 256> buffer{};
+  std::string line;
+  if (fgets(buffer.data(), buffer.size(), pipe)) line = buffer.data();
+  const int status = pclose(pipe);
+  while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+  if (status != 0 || line.empty()) return "unknown";
+  return line;
+}
+
+/// Appends one history record for the merged run to `path` (JSON lines; the file is rewritten
+/// atomically with the new line at the end).
+void bench_history_append(const std::string& path, const json& merged, const CliArgs& a) {
+  json record;
+  record["commit"] = first_line_or_unknown("git rev-parse HEAD");
+  record["dirty"] =
+      first_line_or_unknown("git status --porcelain --untracked-files=no") != "unknown";
+  const std::time_t now = std::time(nullptr);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  record["date"] = date;
+  const json& context = merged["context"];
+  record["machine"] = {{"host_name", context.value("host_name", std::string())},
+                       {"num_cpus", context.value("num_cpus", 0)},
+                       {"mhz_per_cpu", context.value("mhz_per_cpu", 0)}};
+  record["smoke"] = a.flag("--smoke");
+  json benchmarks = json::object();
+  const std::string tmp = path + ".run.json";
+  file_write_atomically(tmp, [&](std::ostream& os) { os << merged.dump() << "\n"; });
+  std::map<std::string, BenchTimes> times;
+  try {
+    times = bench_read(tmp);
+  } catch (...) {
+    std::filesystem::remove(tmp);
+    throw;
+  }
+  std::filesystem::remove(tmp);
+  for (const auto& [name, t] : times) {
+    if (t.error) continue;
+    auto range = [](const std::vector<double>& v, double median) {
+      if (v.empty()) return json::array({median, median});
+      return json::array(
+          {*std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end())});
+    };
+    benchmarks[name] = {{"real_median", t.real_seconds},
+                        {"cpu_median", t.cpu_seconds},
+                        {"real_range", range(t.real_samples, t.real_seconds)},
+                        {"cpu_range", range(t.cpu_samples, t.cpu_seconds)},
+                        {"repetitions", std::max<size_t>(t.real_samples.size(), 1)}};
+  }
+  record["benchmarks"] = benchmarks;
+  std::string existing;
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (in) existing.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  if (!existing.empty() && existing.back() != '\n') existing += '\n';
+  file_write_atomically(path, [&](std::ostream& os) { os << existing << record.dump() << "\n"; });
+  std::cerr << "hexrefine bench: history record appended to " << path << "\n";
 }
 
 int bench_run(const CliArgs& a) {
@@ -305,6 +382,7 @@ int bench_run(const CliArgs& a) {
   merged["benchmarks"] = std::move(benchmarks);
 
   const std::string text = merged.dump(2) + "\n";
+  if (const auto history = a.value("--history")) bench_history_append(*history, merged, a);
   if (const auto out = a.value("--out")) {
     file_write_atomically(*out, [&](std::ostream& os) { os << text; });
     std::cerr << "hexrefine bench: " << merged["benchmarks"].size() << " entries written to "
@@ -354,15 +432,25 @@ int bench_compare_run(const CliArgs& a) {
     ++compared;
     const double base_t = by == "cpu" ? b.cpu_seconds : b.real_seconds;
     const double new_t = by == "cpu" ? n.cpu_seconds : n.real_seconds;
+    const std::vector<double>& base_samples = by == "cpu" ? b.cpu_samples : b.real_samples;
+    const std::vector<double>& new_samples = by == "cpu" ? n.cpu_samples : n.real_samples;
+    // Beyond the threshold and beyond the spread: with >= 3 repetitions on both sides the
+    // samples must differ by the one-sided Mann-Whitney test at 5 %; with fewer there is no
+    // spread to test against and the ratio decides (marked "?").
+    const bool spread = base_samples.size() >= 3 && new_samples.size() >= 3;
     std::string flag;
     if (base_t > 0.0) {
       const double r = new_t / base_t;
-      if (r > 1.0 + threshold) {
-        flag = "slower";
+      if (r > 1.0 + threshold &&
+          (!spread || mann_whitney_p_greater(base_samples, new_samples) <= 0.05)) {
+        flag = spread ? "slower" : "slower?";
         ++slower;
-      } else if (r < 1.0 - threshold) {
-        flag = "faster";
+      } else if (r < 1.0 - threshold &&
+                 (!spread || mann_whitney_p_greater(new_samples, base_samples) <= 0.05)) {
+        flag = spread ? "faster" : "faster?";
         ++faster;
+      } else if (spread && (r > 1.0 + threshold || r < 1.0 - threshold)) {
+        flag = "within spread";
       }
     }
     std::cout << std::setw(10) << ratio_text(b.real_seconds, n.real_seconds) << "  " << std::setw(9)
@@ -391,6 +479,7 @@ const CliCommand cli_bench_command = {
         {"--out", "FILE.json", "write the merged JSON here (default: stdout)"},
         {"--repetitions", "N", "repeat each benchmark N times (1..1000): median and spread"},
         {"--smoke", "", "smallest sizes only, minimal time (CI)"},
+        {"--history", "FILE.jsonl", "append a record of this run (commit, date, machine, medians)"},
     },
     "",
     bench_run,

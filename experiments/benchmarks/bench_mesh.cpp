@@ -1,5 +1,6 @@
 /// Google Benchmark of the mesh layer's per-mesh passes: the checker (mesh_check with a
-/// reference: the mesh itself, so every reference comparison runs and passes), the quality pass
+/// reference: the mesh itself, so every reference comparison runs and passes; one and two
+/// threads), the quality pass
 /// (mesh_scaled_jacobians) on n^3 bricks (n = 25, 50; 10 under --smoke) and on the shared
 /// rockerarm mesh (10,600 hexes), and writing a brick (25^3; 10^3 under --smoke) in each format
 /// to a temporary folder.
@@ -33,10 +34,10 @@ HexMesh unit_brick(int n) {
   return generate_brick(p);
 }
 
-void check_mesh(benchmark::State& state, const HexMesh& mesh) {
+void check_mesh(benchmark::State& state, const HexMesh& mesh, int threads = 1) {
   bool ok = true;
   for (auto _ : state) {
-    const MeshCheckReport report = mesh_check(mesh, &mesh);
+    const MeshCheckReport report = mesh_check(mesh, &mesh, threads);
     ok = ok && report.valid();
     benchmark::DoNotOptimize(report);
   }
@@ -62,6 +63,12 @@ void bench_check_brick(benchmark::State& state) {
   check_mesh(state, mesh);
 }
 
+void bench_check_brick_2_threads(benchmark::State& state) {
+  bench_reset_peak_memory();
+  const HexMesh mesh = unit_brick(static_cast<int>(state.range(0)));
+  check_mesh(state, mesh, 2);
+}
+
 void bench_quality_brick(benchmark::State& state) {
   bench_reset_peak_memory();
   const HexMesh mesh = unit_brick(static_cast<int>(state.range(0)));
@@ -83,7 +90,7 @@ void on_rockerarm(benchmark::State& state, Body body) {
 }
 
 void bench_check_rockerarm(benchmark::State& state) {
-  on_rockerarm(state, check_mesh);
+  on_rockerarm(state, [](benchmark::State& s, const HexMesh& m) { check_mesh(s, m); });
 }
 void bench_quality_rockerarm(benchmark::State& state) {
   on_rockerarm(state, quality_mesh);
@@ -129,6 +136,7 @@ void single(benchmark::internal::Benchmark* b) {
 }
 
 BENCHMARK(bench_check_brick)->Apply(brick_sizes);
+BENCHMARK(bench_check_brick_2_threads)->Apply(brick_sizes);
 BENCHMARK(bench_quality_brick)->Apply(brick_sizes);
 BENCHMARK(bench_check_rockerarm)->Apply(single);
 BENCHMARK(bench_quality_rockerarm)->Apply(single);

@@ -187,6 +187,63 @@ w("- **With composites the factor goes too**: the rounds of each hex configurati
 w("  once on the reference cube and applied as one template, so the sheet refiner writes its")
 w(f"  output once, like the selective one ({sheet75 / sel75:.2f} times its time at 75^3, same mesh).")
 w("")
+
+
+def command_section():
+    """The issue-14 section from command.json (measure_command.sh), if it exists."""
+    path = os.path.join(here, "command.json")
+    if not os.path.exists(path):
+        return
+    c = load("command.json")
+    runs = {r["name"]: r for r in c["runs"]}
+    w("## The whole command (issue 14)")
+    w("")
+    w(f"From `results/performance/measure_command.sh` (`command.json`), {c['date']}, commit "
+      f"`{c['commit'][:10]}`, {c['cpus']} cores, load average at the start {c['load_average']}.")
+    w("`hexrefine refine b75.e OUT --method selective --select all --placement trilinear` (421,875")
+    w("-> 11,390,625 hexes) and `hexrefine check` of its output; one run each, wall time of the")
+    w("whole process, stage times from its report, peak memory from `/usr/bin/time -v`.")
+    w("")
+    w("| command | threads | wall s | read | refine | check | write | peak MB | target |")
+    w("|---|---:|---:|---:|---:|---:|---:|---:|---|")
+    for ext in ("e", "vtu"):
+        for threads in (1, 2):
+            r = runs.get(f"refine_{ext}_threads_{threads}")
+            if not r:
+                continue
+            st = (r.get("report") or {}).get("stage_seconds", {})
+            cells = " | ".join(f"{st.get(k, float('nan')):.2f}" for k in ("read", "refine", "check", "write"))
+            w(f"| refine to .{ext} | {threads} | {r['wall_s']:.2f} | {cells} | {r['peak_rss_MB']} | "
+              f"<= 3 s, <= 2.5 GB: {'met' if r['wall_s'] <= 3 and r['peak_rss_MB'] <= 2560 else 'not met'} |")
+    for threads in (1, 2):
+        r = runs.get(f"check_e_threads_{threads}")
+        if not r:
+            continue
+        st = (r.get("report") or {}).get("stage_seconds", {})
+        w(f"| check .e | {threads} | {r['wall_s']:.2f} | {st.get('read', float('nan')):.2f} | | "
+          f"{st.get('check', float('nan')):.2f} | | {r['peak_rss_MB']} | <= 3 s, <= 1.5 GB: "
+          f"{'met' if r['wall_s'] <= 3 and r['peak_rss_MB'] <= 1536 else 'not met'} |")
+    w("")
+    size_e, size_vtu = c["output_bytes"]["e"], c["output_bytes"]["vtu"]
+    raw = 11390625 * (8 * 4 + 4 + 1) + 11543176 * 24  # Int32 connectivity, offsets, types; Float64 points
+    w(f"Output sizes: Exodus II {size_e / 1e9:.2f} GB, VTU {size_vtu / 1e9:.2f} GB (the raw arrays: "
+      f"{raw / 1e9:.2f} GB). The machine's file-system floor: `dd` writes {size_e / 1e9:.2f} GB of "
+      f"zeros into the page cache in {c['page_cache_write_floor_s']:.2f} s, so no command that "
+      "writes the Exodus file can finish here in much under that; the 3 s target leaves the rest "
+      "of the command (read, refine, check) well under a second, which it is not.")
+    w("")
+    w("Before the issue-14 changes (the issue's measurements on this machine): refine to .e 15.8 s")
+    w("and 2.35 GB peak, to .vtu 19.0 s; check of the output 35.4 s and 4.67 GB. What changed:")
+    w("the checker matches faces by a counting sort of face slots instead of building the")
+    w("topology (and counts the dual sheets only with `--sheets`), finds duplicate nodes by a")
+    w("counting sort into cells, shares edge vectors between quality samples and runs on both")
+    w("cores with `--threads`; readers reject non-manifold input the same way; Exodus II is")
+    w("written definitions-first (no header growth moving written data) and read and written in")
+    w("1 M-entry chunks instead of whole-mesh copies.")
+    w("")
+
+
+command_section()
 with open(os.path.join(repo, "results", "performance.md"), "w") as f:
     f.write("\n".join(lines))
 print("wrote results/performance.md")

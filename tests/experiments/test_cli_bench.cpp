@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "cli_runner.hpp"
@@ -115,8 +116,35 @@ TEST(CliBenchCompare, UsesTheMedianAggregateWhenRepetitionsExist) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string line = line_of(r.output, "rep/5");
   EXPECT_NE(line.find("1.500  "), std::string::npos) << r.output;
-  EXPECT_NE(line.find("slower"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("summary: 1 compared"), std::string::npos) << r.output;
+  // 1.5 times the median, but the repetitions overlap (10 and 30 on both sides): U = 6 of 9,
+  // p = 0.35, so not a regression.
+  EXPECT_NE(line.find("within spread"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("summary: 1 compared, 0 slower"), std::string::npos) << r.output;
+}
+
+TEST(CliBenchCompare, FlagsOnlyChangesBeyondTheSpreadOfRepetitions) {
+  const auto dir = test_temp_dir("cli_bench_compare_spread");
+  const std::string base =
+      write_file(dir, "base.json",
+                 document({entry("apart/5", 100, 100, "ms"), entry("apart/5", 101, 101, "ms"),
+                           entry("apart/5", 99, 99, "ms"), entry("noisy/5", 100, 100, "ms"),
+                           entry("noisy/5", 110, 110, "ms"), entry("noisy/5", 90, 90, "ms"),
+                           entry("single/5", 100, 100, "ms")}));
+  const std::string now =
+      write_file(dir, "new.json",
+                 document({entry("apart/5", 110, 110, "ms"), entry("apart/5", 111, 111, "ms"),
+                           entry("apart/5", 109, 109, "ms"), entry("noisy/5", 95, 95, "ms"),
+                           entry("noisy/5", 150, 150, "ms"), entry("noisy/5", 120, 120, "ms"),
+                           entry("single/5", 110, 110, "ms")}));
+  const CliRun r = cli_run("bench-compare " + base + " " + now);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // Every new repetition above every base one: U = 9, p = 1/20 = 0.05.
+  EXPECT_NE(line_of(r.output, "apart/5").find("  slower"), std::string::npos) << r.output;
+  // Median ratio 1.2 but U = 7: p = 4/20.
+  EXPECT_NE(line_of(r.output, "noisy/5").find("within spread"), std::string::npos) << r.output;
+  // One run each: no spread to test, the ratio flags with a question mark.
+  EXPECT_NE(line_of(r.output, "single/5").find("slower?"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("summary: 3 compared, 2 slower"), std::string::npos) << r.output;
 }
 
 TEST(CliBenchCompare, AcceptsTheNaNGoogleBenchmarkPrints) {
@@ -181,6 +209,32 @@ TEST(CliBench, BadUsageExitsTwo) {
   EXPECT_EQ(cli_run("bench extra").exit_code, 2);
   EXPECT_EQ(cli_run("bench --repetitions 0").exit_code, 2);
   EXPECT_EQ(cli_run("bench --filter").exit_code, 2);
+}
+
+TEST(CliBench, HistoryGetsOneRecordPerRun) {
+  const auto dir = test_temp_dir("cli_bench_history");
+  const std::string history = (dir / "history.jsonl").string();
+  for (int run = 0; run < 2; ++run) {
+    const CliRun r = cli_run(
+        "bench --smoke --filter 'bench_check_rockerarm' --repetitions 3 "
+        "--history " +
+        history + " --out " + (dir / "out.json").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  std::ifstream in(history);
+  std::string line;
+  int records = 0;
+  while (std::getline(in, line)) {
+    const nlohmann::json j = nlohmann::json::parse(line);
+    ++records;
+    EXPECT_TRUE(j.contains("commit") && j.contains("date") && j.contains("machine")) << line;
+    EXPECT_EQ(j["smoke"], true);
+    const nlohmann::json& b = j["benchmarks"]["bench_check_rockerarm/real_time"];
+    EXPECT_EQ(b["repetitions"], 3) << line;
+    EXPECT_LE(b["real_range"][0].get<double>(), b["real_median"].get<double>());
+    EXPECT_GE(b["real_range"][1].get<double>(), b["real_median"].get<double>());
+  }
+  EXPECT_EQ(records, 2);
 }
 
 }  // namespace

@@ -1,0 +1,69 @@
+#!/usr/bin/env python3
+"""Plots results/bench/history.jsonl (one record per `hexrefine bench --history` run): for each
+benchmark matching PATTERN (a regex; default: the refiners' and the command's largest sizes and
+the checker), the median CPU time of every run with its repetitions' range as an error bar, in
+run order, labelled by date and commit. Writes results/bench/history.png.
+
+usage: plot_history.py [HISTORY.jsonl] [--pattern REGEX] [--out PNG]
+"""
+import argparse
+import json
+import math
+import os
+import re
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+here = os.path.dirname(os.path.abspath(__file__))
+parser = argparse.ArgumentParser()
+parser.add_argument("history", nargs="?", default=os.path.join(here, "history.jsonl"))
+parser.add_argument("--pattern",
+                    default=r"bench_(full_brick|radial)/(selective|sheet)/50/|bench_command/"
+                            r"exodus(_2_threads)?/50/|bench_check_brick(_2_threads)?/50/")
+parser.add_argument("--out", default=os.path.join(here, "history.png"))
+args = parser.parse_args()
+
+records = []
+with open(args.history) as f:
+    for number, line in enumerate(f, 1):
+        if line.strip():
+            try:
+                records.append(json.loads(line))
+            except json.JSONDecodeError as e:
+                raise SystemExit(f"{args.history}:{number}: not JSON: {e}")
+if not records:
+    raise SystemExit(f"{args.history}: no records")
+pattern = re.compile(args.pattern)
+names = sorted({n for r in records for n in r["benchmarks"] if pattern.search(n)})
+if not names:
+    raise SystemExit(f"no benchmark matches {args.pattern!r}")
+columns = 2
+rows = math.ceil(len(names) / columns)
+fig, axes = plt.subplots(rows, columns, figsize=(11, 2.6 * rows), squeeze=False)
+labels = [f"{r['date'][:10]}\n{r['commit'][:7]}" for r in records]
+for ax, name in zip(axes.flat, names):
+    xs, ys, lo, hi = [], [], [], []
+    for i, r in enumerate(records):
+        b = r["benchmarks"].get(name)
+        if not b:
+            continue
+        xs.append(i)
+        ys.append(b["cpu_median"])
+        lo.append(b["cpu_median"] - b["cpu_range"][0])
+        hi.append(b["cpu_range"][1] - b["cpu_median"])
+    ax.errorbar(xs, ys, yerr=[lo, hi], marker="o", capsize=3)
+    ax.set_title(name, fontsize=8)
+    ax.set_ylabel("CPU s")
+    ax.set_ylim(bottom=0)
+    ax.set_xticks(range(len(records)))
+    ax.set_xticklabels(labels, fontsize=6)
+for ax in list(axes.flat)[len(names):]:
+    ax.axis("off")
+fig.suptitle("hexrefine bench history: median CPU time per run, bars = range of repetitions")
+fig.tight_layout()
+fig.savefig(args.out + ".tmp.png", dpi=100)
+os.replace(args.out + ".tmp.png", args.out)
+print(f"wrote {args.out} ({len(names)} benchmarks, {len(records)} runs)")

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Measures the issue-14 end-to-end targets: the `hexrefine refine` command on a 75^3 brick (all
+# hexes, Selective Approach, trilinear placement) to Exodus II and to VTU, one and two threads,
+# and `hexrefine check` of its 11.4 M-hex output; wall time, stage times (--report) and peak
+# memory (/usr/bin/time -v) of each command, output sizes, and the floor of this machine's file
+# system: the time `dd` takes to write as many bytes into the page cache. Writes
+# results/performance/command.json; report.py turns it into a section of results/performance.md.
+# Needs a Release build (cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && make -C build hexrefine)
+# and about 3 GB of memory and 3 GB of disk in $TMPDIR; about 2 minutes on an idle machine.
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/../.." && pwd)
+bin=$repo/build/experiments/hexrefine
+out=$repo/results/performance/command.json
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+"$bin" generate brick "$tmp/b75.e" --dims 75,75,75 > /dev/null
+runs=()
+# run NAME COMMAND...: the command's wall time and peak memory, its report if it wrote one.
+run() {
+  local name=$1
+  shift
+  /usr/bin/time -v -o "$tmp/$name.time" "$@" > /dev/null 2> "$tmp/$name.err" || {
+    cat "$tmp/$name.err" >&2
+    exit 1
+  }
+  local wall peak report="null"
+  wall=$(grep 'Elapsed (wall clock)' "$tmp/$name.time" | awk '{print $NF}' |
+    awk -F: '{ if (NF == 3) print $1 * 3600 + $2 * 60 + $3; else print $1 * 60 + $2 }')
+  peak=$(grep 'Maximum resident' "$tmp/$name.time" | awk '{print $6}')
+  [ -f "$tmp/$name.json" ] && report=$(cat "$tmp/$name.json")
+  runs+=("{\"name\": \"$name\", \"wall_s\": $wall, \"peak_rss_MB\": $((peak / 1024)), \"report\": $report}")
+}
+for threads in 1 2; do
+  for ext in e vtu; do
+    run "refine_${ext}_threads_$threads" "$bin" refine "$tmp/b75.e" "$tmp/out.$ext" \
+      --method selective --select all --placement trilinear --threads "$threads" \
+      --report "$tmp/refine_${ext}_threads_$threads.json"
+  done
+done
+size_e=$(stat -c %s "$tmp/out.e")
+size_vtu=$(stat -c %s "$tmp/out.vtu")
+for threads in 1 2; do
+  run "check_e_threads_$threads" "$bin" check "$tmp/out.e" --threads "$threads" \
+    --report "$tmp/check_e_threads_$threads.json"
+done
+# The file-system floor: writing size_e bytes of zeros into the page cache (no computation).
+start=$(date +%s%N)
+dd if=/dev/zero of="$tmp/floor" bs=16M count=$(((size_e + 16777215) / 16777216)) status=none
+end=$(date +%s%N)
+floor=$(awk "BEGIN { print ($end - $start) / 1e9 }")
+{
+  echo "{"
+  echo "  \"date\": \"$(date -u +%Y-%m-%dT%H:%M:%SZ)\", \"commit\": \"$(git -C "$repo" rev-parse HEAD)\","
+  echo "  \"cpus\": $(nproc), \"load_average\": \"$(cut -d' ' -f1-3 /proc/loadavg)\","
+  echo "  \"output_bytes\": {\"e\": $size_e, \"vtu\": $size_vtu},"
+  echo "  \"page_cache_write_floor_s\": $floor,"
+  echo "  \"runs\": ["
+  for i in "${!runs[@]}"; do
+    [ "$i" -gt 0 ] && echo ","
+    echo "    ${runs[$i]}"
+  done
+  echo "  ]"
+  echo "}"
+} > "$out.tmp"
+python3 -c "import json,sys; json.load(open(sys.argv[1]))" "$out.tmp"
+mv "$out.tmp" "$out"
+echo "wrote $out"

@@ -101,6 +101,14 @@ std::span<const RefineMethod> refine_methods() {
   return methods;
 }
 
+PassBuffer pass_buffer_from_name(std::string_view name) {
+  if (name == "layer") return PassBuffer::layer;
+  if (name == "none") return PassBuffer::none;
+  if (name == "transitions") return PassBuffer::transitions;
+  throw InputError("unknown pass buffer '" + std::string(name) +
+                   "' (expected layer, none or transitions)");
+}
+
 const RefineMethod& refine_method(std::string_view name) {
   std::string known;
   for (const RefineMethod& m : methods) {
@@ -136,10 +144,28 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
   }
   HexMesh output;
   BoundaryReference reference;  // the input's boundary, where boundary nodes stay
-  std::vector<int32_t> pass_targets = targets.hexes;
+  // `core`: the descendants of the user's targets in the current mesh (ascending).
+  std::vector<int32_t> core = targets.hexes;
+  const bool layered =
+      method.uses_buffer && options.passes > 1 && options.buffer == PassBuffer::layer;
   for (int pass = 0; pass < options.passes; ++pass) {
     auto t = Clock::now();
     const HexTopology topology = topology_build(*current);
+    std::vector<int32_t> pass_targets = core;
+    if (layered) {
+      std::vector<uint8_t> in_pass(static_cast<size_t>(current->hex_count()), 0);
+      for (int32_t h : core) in_pass[h] = 1;
+      for (int32_t h : core)
+        for (int lf = 0; lf < 6; ++lf) {
+          const int32_t g = hex_face_neighbor(topology, h, lf);
+          if (g >= 0 && !in_pass[g]) {
+            in_pass[g] = 1;
+            pass_targets.push_back(g);
+            ++stats.added_targets;
+          }
+        }
+      std::sort(pass_targets.begin(), pass_targets.end());
+    }
     const RefinementPlan plan = method.plan(*current, topology, pass_targets, options, stats);
     stats.phase_seconds["plan"] += seconds_since(t);
 
@@ -164,19 +190,22 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
     stats.phase_seconds["placement"] += seconds_since(t);
 
     if (pass + 1 < options.passes) {
-      // The next pass refines the descendants of this pass's targets (and its transitions'
-      // with the buffer).
+      // The next pass's core: the children of this pass's core (with PassBuffer::transitions
+      // also of every other hex this pass refined, which then count as added targets).
+      std::vector<uint8_t> in_core(static_cast<size_t>(current->hex_count()), 0);
+      for (int32_t h : core) in_core[h] = 1;
+      const bool transitions = method.uses_buffer && options.buffer == PassBuffer::transitions;
       std::vector<int32_t> next;
       for (size_t u = 0; u < plan.uses.size(); ++u) {
         const TemplateUse& use = plan.uses[u];
-        const bool carried = use.target || (options.buffer && method.uses_buffer);
-        if (!carried) continue;
+        const bool from_core = in_core[index_of(use.hex)];
+        if (!from_core && !transitions) continue;
         const int32_t first = applied.first_child[u];
         const int32_t count = static_cast<int32_t>(use.tmpl->children.size());
         for (int32_t c = first; c < first + count; ++c) next.push_back(c);
-        if (!use.target) stats.added_targets += count;
+        if (!from_core) stats.added_targets += count;
       }
-      pass_targets = std::move(next);
+      core = std::move(next);
     }
     output = std::move(applied.mesh);
     current = &output;

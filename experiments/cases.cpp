@@ -76,8 +76,9 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
                         {"sphere:1,0,0,0.6"}, {{"table", "ring"}});
   ring["save_mesh"] = true;
   cases.push_back(ring);
-  for (const bool buffer : {true, false}) {
-    json c = make_case(buffer ? "H-2" : "H-2/no-buffer", brick(4, 4, 4), {"boundary:-1,0,0"},
+  for (const char* buffer : {"layer", "none", "transitions"}) {
+    const std::string name = std::string(buffer) == "layer" ? "H-2" : "H-2/" + std::string(buffer);
+    json c = make_case(name, brick(4, 4, 4), {"boundary:-1,0,0"},
                        {{"table", "H-2"}, {"buffer", buffer}});
     c["passes"] = 3;
     c["options"]["buffer"] = buffer;
@@ -172,7 +173,7 @@ json real_mesh_study_cases(const std::vector<std::string>& mesh_files,
         c["options"] = {{"placement", placement}};
         if (kind.passes > 1) {
           c["passes"] = kind.passes;
-          c["options"]["buffer"] = true;
+          c["options"]["buffer"] = "layer";
         }
         cases.push_back(c);
       }

@@ -13,8 +13,8 @@
 /// - 6-2 (quarter piston, top surfaces, smoothed): ellipsoid.mesh, `boundary:0,0,1,45` (boundary
 ///   faces facing up within 45 degrees), smoothed afterwards.
 /// - H-1: generate_gear's defaults (8,568 hexes), `block:2` (the teeth), smoothed afterwards.
-/// - H-2: 4x4x4 unit brick, `boundary:-1,0,0`, 3 passes, with buffer (the thesis' selective
-///   run) and without ("H-2/no-buffer").
+/// - H-2: 4x4x4 unit brick, `boundary:-1,0,0`, 3 passes, with the thesis' buffer rule
+///   (PassBuffer::layer), and as ablations "H-2/none" and "H-2/transitions".
 /// - H-3 (mechanical plate, neck region): cube_minus_sphere_conforming.mesh,
 ///   `sphere:0.275,0.275,0,0.15` (a ball about the middle of one of the cube's edges).
 /// - H-4 (hook, every hex): rockerarm.mesh, `all`.

@@ -49,7 +49,8 @@ int refine_run(const CliArgs& a) {
     throw InputError("hexrefine refine: at least one --select SPEC (e.g. --select all)");
   if (const auto p = a.value("--passes"))
     o.refine.passes = static_cast<int>(cli_parse_int_in(*p, 1, 10, "--passes"));
-  o.refine.buffer = a.flag("--buffer");
+  if (const auto buffer = a.value("--buffer")) o.refine.buffer = pass_buffer_from_name(*buffer);
+  if (a.flag("--no-buffer")) o.refine.buffer = PassBuffer::none;
   o.refine.ranking = !a.flag("--no-ranking");
   o.refine.propagation = !a.flag("--no-propagation");
   o.refine.ebe_only = a.flag("--ebe-only");
@@ -111,7 +112,10 @@ const CliCommand cli_refine_command = {
          "boundary:nx,ny,nz[,deg], block:ID[,ID]",
          true},
         {"--passes", "N", "refine the region N times, 1..10 (default 1)"},
-        {"--buffer", "", "selective: the previous pass's transitions join the next targets"},
+        {"--buffer", "RULE",
+         "selective, passes > 1: layer (default: one layer around the targets, the thesis' "
+         "H-2), transitions (every transition's children, cumulative) or none"},
+        {"--no-buffer", "", "ablation: the same as --buffer none"},
         {"--placement", "P",
          "new nodes: trilinear (the thesis' positions) or optimized "
          "(default: raise the worst scaled Jacobian, untangle)"},

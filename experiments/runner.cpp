@@ -160,7 +160,13 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
     if (o.contains("propagation"))
       c.options.propagation = schema_bool(o["propagation"], op.at("propagation"));
     if (o.contains("ebe_only")) c.options.ebe_only = schema_bool(o["ebe_only"], op.at("ebe_only"));
-    if (o.contains("buffer")) c.options.buffer = schema_bool(o["buffer"], op.at("buffer"));
+    if (o.contains("buffer")) {
+      // A rule name; the booleans of earlier case files mean what they meant then.
+      if (o["buffer"].is_boolean())
+        c.options.buffer = o["buffer"].get<bool>() ? PassBuffer::transitions : PassBuffer::none;
+      else
+        c.options.buffer = pass_buffer_from_name(schema_string(o["buffer"], op.at("buffer")));
+    }
     if (o.contains("allow_inverted"))
       c.options.allow_inverted = schema_bool(o["allow_inverted"], op.at("allow_inverted"));
     if (o.contains("placement")) {

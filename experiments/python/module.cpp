@@ -227,7 +227,7 @@ PYBIND11_MODULE(_hexrefine, m) {
   m.def(
       "refine",
       [](const HexMesh& mesh, const py::object& targets, const std::string& method, int passes,
-         bool buffer, bool smooth, bool ranking, bool propagation, bool ebe_only,
+         const std::string& buffer, bool smooth, bool ranking, bool propagation, bool ebe_only,
          const std::string& placement, int threads, bool allow_inverted, int64_t max_hexes) {
         PipelineOptions o;
         o.method = method;
@@ -262,7 +262,7 @@ PYBIND11_MODULE(_hexrefine, m) {
           o.targets->erase(std::unique(o.targets->begin(), o.targets->end()), o.targets->end());
         }
         o.refine.passes = passes;
-        o.refine.buffer = buffer;
+        o.refine.buffer = pass_buffer_from_name(buffer);
         o.refine.ranking = ranking;
         o.refine.propagation = propagation;
         o.refine.ebe_only = ebe_only;
@@ -281,7 +281,7 @@ PYBIND11_MODULE(_hexrefine, m) {
         }
         return py::make_tuple(std::move(r.mesh), json_to_python(pipeline_report(r, o)));
       },
-      "mesh"_a, "targets"_a, "method"_a = "selective", "passes"_a = 1, "buffer"_a = false,
+      "mesh"_a, "targets"_a, "method"_a = "selective", "passes"_a = 1, "buffer"_a = "layer",
       "smooth"_a = false, "ranking"_a = true, "propagation"_a = true, "ebe_only"_a = false,
       "placement"_a = "optimized", "threads"_a = 1, "allow_inverted"_a = false,
       "max_hexes"_a = int64_t{2147483647},
@@ -289,7 +289,8 @@ PYBIND11_MODULE(_hexrefine, m) {
       "apply, place the new nodes (placement 'optimized' or the thesis' 'trilinear'), check "
       "against the input, optionally smooth and check again. Returns (mesh, report): the mesh "
       "with template_tag, refinement_level and parent_hex attributes, the report a dict with the "
-      "keys of `hexrefine refine --report`. RefinementError if the method refuses or the result "
+      "keys of `hexrefine refine --report`. `buffer` (passes > 1): 'layer' (the thesis' rule), "
+      "'transitions' or 'none'. RefinementError if the method refuses or the result "
       "is invalid (unless an ablation switch or allow_inverted); ValueError for bad input.");
   m.def(
       "check",

@@ -109,7 +109,7 @@ TEST(NodePlacement, FormerRefusalsAreUntangledAndValid) {
     const HexMesh m = mesh_read(shared_mesh(f.file));
     RefineOptions o;
     o.passes = f.passes;
-    o.buffer = f.passes > 1;
+    o.buffer = f.passes > 1 ? PassBuffer::layer : PassBuffer::none;
     const Targets t{select_hexes(m, {f.select}).hexes};
     const RefineResult r = refine(refine_method(f.method), m, t, o);
     const MeshCheckReport c = mesh_check(r.mesh, &m);

@@ -403,15 +403,50 @@ TEST(SelectivePasses, RegionRefinedTwiceWithAndWithoutBuffer) {
     if (h % 4 == 0) left.push_back(h);
   RefineOptions o;
   o.passes = 2;
+  o.buffer = PassBuffer::none;
   RefineResult plain;
   EXPECT_TRUE(refine_and_check(m, left, &plain, o).valid());
   // Pass 2 targets the 16 x 27 children of the targets: 432 x 27 of them after two passes.
   EXPECT_EQ(plain.stats.hexes_per_template.at("1-27"), 16 * 27 * 27);
-  o.buffer = true;
+  o.buffer = PassBuffer::transitions;
   RefineResult buffered;
   EXPECT_TRUE(refine_and_check(m, left, &buffered, o).valid());
   EXPECT_GT(buffered.stats.added_targets, 0);
   EXPECT_GT(buffered.mesh.hex_count(), plain.mesh.hex_count());
+}
+
+TEST(SelectivePasses, TableH2UnderEachPassBufferRule) {
+  // Thesis Table H-2: 4x4x4 brick, the left surface refined three times; trilinear placement
+  // (the thesis' positions). The layer rule (the default) gives the thesis' count and minimum.
+  const HexMesh m = fixture_brick(4, 4, 4);
+  std::vector<int32_t> left;
+  for (int32_t h = 0; h < m.hex_count(); ++h)
+    if (h % 4 == 0) left.push_back(h);
+  struct Expected {
+    PassBuffer buffer;
+    int32_t hexes;
+    double min_scaled_jacobian;
+  };
+  for (const Expected& e : {Expected{PassBuffer::layer, 370304, 4.0 / 13.0},
+                            Expected{PassBuffer::none, 332448, 0.0038312},
+                            Expected{PassBuffer::transitions, 472384, 4.0 / 13.0}}) {
+    SCOPED_TRACE(static_cast<int>(e.buffer));
+    RefineOptions o;
+    o.passes = 3;
+    o.buffer = e.buffer;
+    o.placement.method = PlacementMethod::trilinear;
+    RefineResult r;
+    const MeshCheckReport c = refine_and_check(m, left, &r, o);
+    EXPECT_TRUE(c.valid());
+    EXPECT_EQ(r.mesh.hex_count(), e.hexes);
+    EXPECT_NEAR(c.min_scaled_jacobian, e.min_scaled_jacobian, 1e-6);
+  }
+  // With one pass the rule adds nothing: the layer is for multiple passes only.
+  RefineOptions one;
+  one.placement.method = PlacementMethod::trilinear;
+  RefineResult r;
+  refine_and_check(m, left, &r, one);
+  EXPECT_EQ(r.stats.added_targets, 0);
 }
 
 TEST(Selective, RefusesInvertedInputAndBadTargets) {

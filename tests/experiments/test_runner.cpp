@@ -120,7 +120,7 @@ TEST(RunPlan, ParsesDefaultsAndResolvesRelativePaths) {
   EXPECT_EQ(b.select[1], "hexes:" + (dir / "sel.txt").string());
   EXPECT_EQ(b.select_given[1], "hexes:sel.txt");
   EXPECT_EQ(b.options.passes, 3);
-  EXPECT_TRUE(b.options.buffer);
+  EXPECT_EQ(b.options.buffer, PassBuffer::transitions);  // the boolean of earlier case files
   EXPECT_FALSE(b.options.ranking);
   EXPECT_TRUE(b.smooth);
   EXPECT_TRUE(b.save_mesh);
@@ -429,9 +429,9 @@ TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
     const json root = thesis_suite_cases(quick, meshes, "thesis.jsonl");
     const RunPlan plan = run_plan_parse(root, "suite.json", "/");
     const size_t sweep = quick ? 6 : 15;  // n = 5..30 or 5..75
-    // G-1, 6-1, 6-2, H-1, ring, H-2 (two), H-3, H-4, real (trilinear placement: the thesis'),
-    // the same ten with optimized placement, 6 ablations, two sweeps.
-    EXPECT_EQ(plan.cases.size(), 26u + 2 * sweep);
+    // G-1, 6-1, 6-2, H-1, ring, H-2 (three buffer rules), H-3, H-4, real (trilinear placement:
+    // the thesis'), the same eleven with optimized placement, 6 ablations, two sweeps.
+    EXPECT_EQ(plan.cases.size(), 28u + 2 * sweep);
     int g2 = 0, ablations = 0, optimized = 0;
     for (const RunCase& c : plan.cases) {
       if (c.options.placement.method == PlacementMethod::optimized) {
@@ -451,7 +451,7 @@ TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
     }
     EXPECT_EQ(g2, static_cast<int>(sweep));
     EXPECT_EQ(ablations, 6);
-    EXPECT_EQ(optimized, 10);
+    EXPECT_EQ(optimized, 11);
     EXPECT_EQ(plan.cases[0].name, "G-1");
     EXPECT_TRUE(plan.cases[0].save_mesh);
     EXPECT_EQ(plan.cases[1].name, "6-1");

@@ -117,10 +117,18 @@ void SelectivePass::rank() {
   }
   stats_.directional_groups += groups;
 
+  const bool by_hex = options_.directional_order == DirectionalOrder::by_hex;
   if (!options_.ranking) {
-    // Ablation: each hex refines its own local x, y, z in turn, hex after hex.
-    for (int32_t di = 0; di < nd; ++di)
-      for (int8_t d = 0; d < 3; ++d) rounds_.push_back({{di, d}});
+    // Ablation: local x, y, z in turn, hex after hex, or each local direction for every hex.
+    if (by_hex) {
+      for (int32_t di = 0; di < nd; ++di)
+        for (int8_t d = 0; d < 3; ++d) rounds_.push_back({{di, d}});
+    } else {
+      for (int8_t d = 0; d < 3; ++d) {
+        rounds_.emplace_back();
+        for (int32_t di = 0; di < nd; ++di) rounds_.back().push_back({di, d});
+      }
+    }
     return;
   }
   // Seeds: (hex, direction) by decreasing split count, then group, hex, direction.
@@ -167,6 +175,16 @@ void SelectivePass::rank() {
     }
   }
   stats_.ranks += static_cast<int64_t>(members.size());
+  if (by_hex) {
+    // The thesis' loop: each hex's directions by increasing rank, one step each, hex after hex.
+    for (int32_t di = 0; di < nd; ++di) {
+      std::array<int8_t, 3> order = {0, 1, 2};
+      std::sort(order.begin(), order.end(),
+                [&](int8_t a, int8_t b) { return rank_of[3 * di + a] < rank_of[3 * di + b]; });
+      for (int8_t d : order) rounds_.push_back({{di, d}});
+    }
+    return;
+  }
   // A hex met twice by one rank (a self-intersecting sheet) refines those directions in turn.
   std::vector<int8_t> seen_in_rank(nd, 0);
   for (auto& m : members) {

@@ -52,6 +52,14 @@ int refine_run(const CliArgs& a) {
   if (const auto buffer = a.value("--buffer")) o.refine.buffer = pass_buffer_from_name(*buffer);
   if (a.flag("--no-buffer")) o.refine.buffer = PassBuffer::none;
   o.refine.ranking = !a.flag("--no-ranking");
+  if (const auto order = a.value("--directional-order")) {
+    if (*order == "by-rank")
+      o.refine.directional_order = DirectionalOrder::by_rank;
+    else if (*order == "by-hex")
+      o.refine.directional_order = DirectionalOrder::by_hex;
+    else
+      throw InputError("--directional-order: expected by-rank or by-hex, got '" + *order + "'");
+  }
   o.refine.propagation = !a.flag("--no-propagation");
   o.refine.ebe_only = a.flag("--ebe-only");
   o.refine.allow_inverted = a.flag("--allow-inverted");
@@ -121,6 +129,8 @@ const CliCommand cli_refine_command = {
          "(default: raise the worst scaled Jacobian, untangle)"},
         {"--smooth", "", "smooth the refined region afterwards (checked again)"},
         {"--no-ranking", "", "ablation: selective without its ranking system"},
+        {"--directional-order", "ORDER",
+         "selective: by-hex (default: the thesis' hex after hex) or by-rank (a rank per step)"},
         {"--no-propagation", "", "ablation: selective without its propagation scheme"},
         {"--ebe-only", "", "ablation: element-by-element templates only"},
         {"--allow-inverted", "", "refine an input with inverted hexes (no refusal, no verdict)"},

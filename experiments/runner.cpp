@@ -154,9 +154,18 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
     const json& o = j["options"];
     const SchemaPath op = p.at("options");
     schema_require_object(o, op);
-    schema_allow_keys(
-        o, op, {"ranking", "propagation", "ebe_only", "buffer", "allow_inverted", "placement"});
+    schema_allow_keys(o, op,
+                      {"ranking", "directional_order", "propagation", "ebe_only", "buffer",
+                       "allow_inverted", "placement"});
     if (o.contains("ranking")) c.options.ranking = schema_bool(o["ranking"], op.at("ranking"));
+    if (o.contains("directional_order")) {
+      const std::string order = schema_string(o["directional_order"], op.at("directional_order"));
+      if (order != "by_rank" && order != "by_hex")
+        op.at("directional_order")
+            .fail("expected \"by_rank\" or \"by_hex\", got \"" + order + "\"");
+      c.options.directional_order =
+          order == "by_hex" ? DirectionalOrder::by_hex : DirectionalOrder::by_rank;
+    }
     if (o.contains("propagation"))
       c.options.propagation = schema_bool(o["propagation"], op.at("propagation"));
     if (o.contains("ebe_only")) c.options.ebe_only = schema_bool(o["ebe_only"], op.at("ebe_only"));
@@ -165,7 +174,11 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
       if (o["buffer"].is_boolean())
         c.options.buffer = o["buffer"].get<bool>() ? PassBuffer::transitions : PassBuffer::none;
       else
-        c.options.buffer = pass_buffer_from_name(schema_string(o["buffer"], op.at("buffer")));
+        try {
+          c.options.buffer = pass_buffer_from_name(schema_string(o["buffer"], op.at("buffer")));
+        } catch (const InputError& e) {
+          op.at("buffer").fail(e.what());
+        }
     }
     if (o.contains("allow_inverted"))
       c.options.allow_inverted = schema_bool(o["allow_inverted"], op.at("allow_inverted"));

@@ -227,8 +227,9 @@ PYBIND11_MODULE(_hexrefine, m) {
   m.def(
       "refine",
       [](const HexMesh& mesh, const py::object& targets, const std::string& method, int passes,
-         const std::string& buffer, bool smooth, bool ranking, bool propagation, bool ebe_only,
-         const std::string& placement, int threads, bool allow_inverted, int64_t max_hexes) {
+         const std::string& buffer, bool smooth, bool ranking, const std::string& directional_order,
+         bool propagation, bool ebe_only, const std::string& placement, int threads,
+         bool allow_inverted, int64_t max_hexes) {
         PipelineOptions o;
         o.method = method;
         if (py::isinstance<py::str>(targets) || py::isinstance<py::list>(targets) ||
@@ -264,6 +265,11 @@ PYBIND11_MODULE(_hexrefine, m) {
         o.refine.passes = passes;
         o.refine.buffer = pass_buffer_from_name(buffer);
         o.refine.ranking = ranking;
+        if (directional_order != "by_rank" && directional_order != "by_hex")
+          throw InputError("directional_order: expected 'by_rank' or 'by_hex', got '" +
+                           directional_order + "'");
+        o.refine.directional_order =
+            directional_order == "by_hex" ? DirectionalOrder::by_hex : DirectionalOrder::by_rank;
         o.refine.propagation = propagation;
         o.refine.ebe_only = ebe_only;
         o.refine.threads = threads;
@@ -282,9 +288,9 @@ PYBIND11_MODULE(_hexrefine, m) {
         return py::make_tuple(std::move(r.mesh), json_to_python(pipeline_report(r, o)));
       },
       "mesh"_a, "targets"_a, "method"_a = "selective", "passes"_a = 1, "buffer"_a = "layer",
-      "smooth"_a = false, "ranking"_a = true, "propagation"_a = true, "ebe_only"_a = false,
-      "placement"_a = "optimized", "threads"_a = 1, "allow_inverted"_a = false,
-      "max_hexes"_a = int64_t{2147483647},
+      "smooth"_a = false, "ranking"_a = true, "directional_order"_a = "by_hex",
+      "propagation"_a = true, "ebe_only"_a = false, "placement"_a = "optimized", "threads"_a = 1,
+      "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647},
       "Refines `targets` (hex ids, or selection specs) by `method` through the pipeline: plan, "
       "apply, place the new nodes (placement 'optimized' or the thesis' 'trilinear'), check "
       "against the input, optionally smooth and check again. Returns (mesh, report): the mesh "

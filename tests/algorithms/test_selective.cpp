@@ -415,6 +415,39 @@ TEST(SelectivePasses, RegionRefinedTwiceWithAndWithoutBuffer) {
   EXPECT_GT(buffered.mesh.hex_count(), plain.mesh.hex_count());
 }
 
+TEST(SelectiveDirectionalOrder, HexByHexAndRankByRankGiveTheSameMesh) {
+  // The thesis' loop (hex after hex, the default) and rank after rank: on the L-shaped case and
+  // a radial region the same mesh, hex for hex and node for node; with the ranking system off
+  // (local x, y, z) both orders again agree with each other (8,210 on G-1).
+  const HexMesh brick10 = fixture_brick(10, 10, 10);
+  std::vector<int32_t> l_shaped;
+  for (int32_t h = 0; h < brick10.hex_count(); ++h)
+    if (h % 10 == 0 || h / 100 == 0) l_shaped.push_back(h);
+  const HexMesh brick20 = fixture_brick(20, 20, 20, 1.0 / 20);
+  const std::vector<int32_t> ball = hexes_within(brick20, {1, 0, 1}, 0.5);
+  struct Case {
+    const HexMesh* mesh;
+    const std::vector<int32_t>* targets;
+    bool ranking;
+    int32_t hexes;
+  };
+  for (const Case& c :
+       {Case{&brick10, &l_shaped, true, 8060}, Case{&brick10, &l_shaped, false, 8210},
+        Case{&brick20, &ball, true, 26428}, Case{&brick20, &ball, false, 26536}}) {
+    RefineResult results[2];
+    for (int k = 0; k < 2; ++k) {
+      RefineOptions o = refine_options_trilinear();
+      o.ranking = c.ranking;
+      o.directional_order = k == 0 ? DirectionalOrder::by_hex : DirectionalOrder::by_rank;
+      EXPECT_TRUE(refine_and_check(*c.mesh, *c.targets, &results[k], o).valid());
+    }
+    EXPECT_EQ(results[0].mesh.hex_count(), c.hexes);
+    EXPECT_EQ(results[0].mesh.hexes, results[1].mesh.hexes);
+    EXPECT_EQ(results[0].mesh.points, results[1].mesh.points);
+  }
+  EXPECT_EQ(RefineOptions{}.directional_order, DirectionalOrder::by_hex);
+}
+
 TEST(SelectivePasses, TableH2UnderEachPassBufferRule) {
   // Thesis Table H-2: 4x4x4 brick, the left surface refined three times; trilinear placement
   // (the thesis' positions). The layer rule (the default) gives the thesis' count and minimum.

@@ -28,6 +28,38 @@ nlohmann::json read_json(const std::filesystem::path& p) {
   return nlohmann::json::parse(in);
 }
 
+TEST(CliRefine, DirectionalOrderAndBufferRuleOptions) {
+  const auto dir = test_temp_dir("cli_refine_order");
+  const std::string in = (dir / "b.mesh").string(), out = (dir / "o.mesh").string();
+  mesh_write(in, fixture_brick(4, 4, 4));
+  // Table H-2 with the thesis' defaults (hex after hex, the layer buffer): 370,304 hexes.
+  CliRun r = cli_run(join({"refine", in, out,
+                           "--method selective --select boundary:-1,0,0 --passes 3 "
+                           "--placement trilinear --directional-order by-rank --report",
+                           (dir / "r.json").string()}));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  nlohmann::json j = read_json(dir / "r.json");
+  EXPECT_EQ(j.at("refine").at("final_hexes"), 370304);
+  EXPECT_EQ(j.at("options").at("directional_order"), "by_rank");
+  EXPECT_EQ(j.at("options").at("buffer"), "layer");
+  r = cli_run(join({"refine", in, out,
+                    "--method selective --select boundary:-1,0,0 --passes 3 --placement "
+                    "trilinear --no-buffer --report",
+                    (dir / "r.json").string()}));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  j = read_json(dir / "r.json");
+  EXPECT_EQ(j.at("refine").at("final_hexes"), 332448);
+  EXPECT_EQ(j.at("options").at("directional_order"), "by_hex");
+  EXPECT_EQ(j.at("options").at("buffer"), "none");
+  EXPECT_EQ(
+      cli_run(join({"refine", in, out, "--method selective --select all --buffer wide"})).exit_code,
+      2);
+  EXPECT_EQ(cli_run(join({"refine", in, out,
+                          "--method selective --select all --directional-order sideways"}))
+                .exit_code,
+            2);
+}
+
 TEST(CliRefine, LShapedCaseWritesMeshAndReport) {
   const auto dir = test_temp_dir("cli_refine_l");
   const std::string in = (dir / "b.vtk").string(), out = (dir / "o.vtk").string();

@@ -207,7 +207,7 @@ TEST(RunRecordKey, OptionsAreCanonical) {
   EXPECT_NE(run_record_key("G-1", "selective", run_options_to_json(defaults, false)),
             run_record_key("G-1", "selective", run_options_to_json(defaults, true)));
   // Every RefineOptions field but threads (the output does not depend on it), and "smooth".
-  EXPECT_EQ(run_options_to_json(defaults, false).size(), 8u);
+  EXPECT_EQ(run_options_to_json(defaults, false).size(), 9u);
   EXPECT_FALSE(run_options_to_json(defaults, false).contains("threads"));
   RefineOptions trilinear;
   trilinear.placement.method = PlacementMethod::trilinear;

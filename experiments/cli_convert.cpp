@@ -26,10 +26,7 @@ int convert_run(const CliArgs& a) {
   const MeshFormat out_format = mesh_format_of(out);
   mesh_format_of(in);
   cli_output_check("hexrefine convert", out, CliOutputKind::mesh);
-  MeshWriteOptions options;
-  options.binary = a.flag("--binary");
-  if (options.binary && out_format != MeshFormat::vtk_legacy)
-    throw InputError("hexrefine convert: --binary applies to .vtk output only (" + out + ")");
+  MeshWriteOptions options = cli_mesh_write_options(a, "hexrefine convert", out);
   const HexMesh mesh = mesh_read(in);
   if (out_format == MeshFormat::vtk_legacy || out_format == MeshFormat::vtu)
     options.cell_scalars.emplace_back("scaled_jacobian", mesh_scaled_jacobians(mesh));
@@ -47,6 +44,8 @@ const CliCommand cli_convert_command = {
     "Converts between mesh formats (by extension: .mesh .vtk .vtu .msh .e/.exo .inp).",
     {
         {"--binary", "", "VTK legacy output in BINARY instead of ASCII (.vtk only)"},
+        {"--ascii", "", "VTU output as text instead of appended binary data (.vtu only)"},
+        {"--compress", "", "VTU output zlib-compressed (.vtu only)"},
     },
     "",
     convert_run,

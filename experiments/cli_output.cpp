@@ -32,4 +32,20 @@ void cli_output_check(const std::string& command, const std::string& path, CliOu
   ::unlink(probe.c_str());
 }
 
+MeshWriteOptions cli_mesh_write_options(const CliArgs& a, const std::string& command,
+                                        const std::string& path) {
+  MeshWriteOptions options;
+  const MeshFormat format = mesh_format_of(path);
+  options.binary = a.flag("--binary");
+  options.ascii = a.flag("--ascii");
+  options.compress = a.flag("--compress");
+  if (options.binary && format != MeshFormat::vtk_legacy)
+    throw InputError(command + ": --binary applies to .vtk output only (" + path + ")");
+  if ((options.ascii || options.compress) && format != MeshFormat::vtu)
+    throw InputError(command + ": --ascii and --compress apply to .vtu output only (" + path + ")");
+  if (options.ascii && options.compress)
+    throw InputError(command + ": --ascii and --compress exclude each other");
+  return options;
+}
+
 }  // namespace hexrefine

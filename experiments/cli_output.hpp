@@ -5,6 +5,9 @@
 
 #include <string>
 
+#include "experiments/cli.hpp"
+#include "mesh/io.hpp"
+
 namespace hexrefine {
 
 /// What a command will write at `path`.
@@ -18,5 +21,11 @@ enum class CliOutputKind { mesh, report };
 /// permissions). A later failure (disk full, the folder removed meanwhile) is still an
 /// OperationError from the writer.
 void cli_output_check(const std::string& command, const std::string& path, CliOutputKind kind);
+
+/// The mesh writer's encoding switches of a command writing `path`: --binary (VTK legacy
+/// BINARY), --ascii and --compress (VTU text, VTU zlib). InputError naming `command` when a
+/// switch does not apply to the format of `path`.
+MeshWriteOptions cli_mesh_write_options(const CliArgs& a, const std::string& command,
+                                        const std::string& path);
 
 }  // namespace hexrefine

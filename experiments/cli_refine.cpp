@@ -79,6 +79,11 @@ int refine_run(const CliArgs& a) {
     o.max_hexes = cli_parse_int_in(*m, 1, std::numeric_limits<int32_t>::max(), "--max-hexes");
   if (a.flag("--verbose")) o.verbose = &std::cerr;
   cli_output_check("hexrefine refine", out, CliOutputKind::mesh);
+  {
+    MeshWriteOptions write = cli_mesh_write_options(a, "hexrefine refine", out);
+    write.cell_scalars = std::move(o.write.cell_scalars);
+    o.write = std::move(write);
+  }
   const std::optional<std::string> report_path = a.value("--report");
   if (report_path) cli_output_check("hexrefine refine", *report_path, CliOutputKind::report);
 
@@ -135,6 +140,9 @@ const CliCommand cli_refine_command = {
         {"--ebe-only", "", "ablation: element-by-element templates only"},
         {"--allow-inverted", "", "refine an input with inverted hexes (no refusal, no verdict)"},
         {"--max-hexes", "N", "refuse when n*27^passes could exceed N (default 2^31-1)"},
+        {"--binary", "", "VTK legacy output in BINARY instead of ASCII (.vtk only)"},
+        {"--ascii", "", "VTU output as text instead of appended binary data (.vtu only)"},
+        {"--compress", "", "VTU output zlib-compressed (.vtu only)"},
         {"--threads", "N",
          "threads for the template application and the check, 1..256 (same output)"},
         {"--report", "R.json", "write the JSON report (stats, checks, stage times)"},

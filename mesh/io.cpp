@@ -229,7 +229,8 @@ void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOpt
     case MeshFormat::vtk_legacy:
       return io_detail::vtk_write(path, mesh, options.binary, options.cell_scalars);
     case MeshFormat::vtu:
-      return io_detail::vtu_write(path, mesh, options.cell_scalars);
+      return io_detail::vtu_write(path, mesh, options.cell_scalars, options.ascii,
+                                  options.compress);
     case MeshFormat::gmsh:
       return io_detail::gmsh_write(path, mesh, options.cell_scalars);
     case MeshFormat::exodus:

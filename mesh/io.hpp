@@ -56,6 +56,10 @@ MeshFormat mesh_format_of(const std::string& path);
 
 struct MeshWriteOptions {
   bool binary = false;  ///< VTK legacy: BINARY instead of ASCII
+  /// VTU: text (format="ascii") instead of the default appended raw binary data.
+  bool ascii = false;
+  /// VTU: zlib-compress the appended data (vtkZLibDataCompressor); ignored with `ascii`.
+  bool compress = false;
   /// Extra per-hex double fields (e.g. "scaled_jacobian"), written as cell data where the format
   /// has it (VTK, VTU; Gmsh as $ElementData). Each needs hex_count() values.
   std::vector<std::pair<std::string, std::vector<double>>> cell_scalars;

@@ -305,7 +305,8 @@ void vtk_write(const std::string& path, const HexMesh& mesh, const bool binary,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
 HexMesh vtu_read(const std::string& path, const std::string& text);
 void vtu_write(const std::string& path, const HexMesh& mesh,
-               const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
+               const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars,
+               bool ascii, bool compress);
 HexMesh gmsh_read(const std::string& path, const std::string& text);
 void gmsh_write(const std::string& path, const HexMesh& mesh,
                 const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);

@@ -173,9 +173,12 @@ PYBIND11_MODULE(_hexrefine, m) {
       "ValueError naming the file and line on bad input.");
   m.def(
       "write",
-      [](const HexMesh& mesh, const std::string& path, bool binary, const py::dict& cell_data) {
+      [](const HexMesh& mesh, const std::string& path, bool binary, bool ascii, bool compress,
+         const py::dict& cell_data) {
         MeshWriteOptions o;
         o.binary = binary;
+        o.ascii = ascii;
+        o.compress = compress;
         for (const auto& [key, value] : cell_data)
           o.cell_scalars.push_back({py::str(key), value.cast<std::vector<double>>()});
         for (const auto& [name, values] : o.cell_scalars)
@@ -184,9 +187,11 @@ PYBIND11_MODULE(_hexrefine, m) {
         py::gil_scoped_release release;
         mesh_write(path, mesh, o);
       },
-      "mesh"_a, "path"_a, "binary"_a = false, "cell_data"_a = py::dict(),
+      "mesh"_a, "path"_a, "binary"_a = false, "ascii"_a = false, "compress"_a = false,
+      "cell_data"_a = py::dict(),
       "Writes a mesh atomically (format by extension); attributes travel where the format holds "
-      "them, cell_data {name: m floats} as cell fields (VTK, VTU, Gmsh, Exodus).");
+      "them, cell_data {name: m floats} as cell fields (VTK, VTU, Gmsh, Exodus). binary: VTK "
+      "legacy BINARY; VTU is appended binary data unless ascii, zlib-compressed with compress.");
   m.def(
       "generate",
       [](const std::string& name, const py::kwargs& params) {

@@ -4,7 +4,8 @@
 usage: check_external_readers.py HEXREFINE SHARED_DIR TEMP_DIR
 
 Converts the shared meshes and a generated jittered brick to every format hexrefine writes
-(.mesh, .vtk ASCII and BINARY, .vtu, .msh, .e, .inp) with `hexrefine convert`, then checks:
+(.mesh, .vtk ASCII and BINARY, .vtu appended binary, zlib and ASCII, .msh, .e, .inp) with
+`hexrefine convert`, then checks:
   - meshio reads every file with the right hex count;
   - VTK (python3-vtk9) reads the .vtk, .vtu and .e files with the right hex count;
   - vtkMeshQuality's hex scaled Jacobian equals our "scaled_jacobian" cell data to 1e-9
@@ -19,7 +20,10 @@ import os
 import subprocess
 import sys
 
-FORMATS = [".mesh", ".vtk", "_binary.vtk", ".vtu", ".msh", ".e", ".inp"]
+FORMATS = [".mesh", ".vtk", "_binary.vtk", ".vtu", "_compressed.vtu", "_ascii.vtu", ".msh", ".e",
+           ".inp"]
+# hexrefine convert's switch for each variant of a format.
+SWITCHES = {"_binary.vtk": ["--binary"], "_compressed.vtu": ["--compress"], "_ascii.vtu": ["--ascii"]}
 # Shared meshes: name -> hex count from shared/meshes/README.md (sphere_sculpt.e: counted by meshio).
 SHARED = {
     "rockerarm.mesh": 10600,
@@ -141,7 +145,7 @@ def main():
     for stem, (source, hexes) in inputs.items():
         for fmt in FORMATS:
             target = os.path.join(tmp, stem + fmt)
-            cmd = [exe, "convert", source, target] + (["--binary"] if fmt == "_binary.vtk" else [])
+            cmd = [exe, "convert", source, target] + SWITCHES.get(fmt, [])
             code, out = run(cmd)
             if code != 0:
                 report(False, "hexrefine convert %s -> %s: exit %d: %s" % (source, target, code, out.strip()))
@@ -151,7 +155,7 @@ def main():
                 report(n == hexes, "meshio reads %s: %d hexes (expected %d)" % (target, n, hexes))
             except Exception as e:  # noqa: BLE001 (any reader failure is a failed check)
                 report(False, "meshio reads %s: %s" % (target, e))
-            if fmt in (".vtk", "_binary.vtk", ".vtu", ".e"):
+            if fmt.endswith(".vtk") or fmt.endswith(".vtu") or fmt == ".e":
                 try:
                     grid = vtk_grid(target)
                     n = vtk_hexes(grid)
@@ -174,6 +178,20 @@ def main():
                 report(ok, "gmsh -check %s: %s, %d negative-volume warnings%s"
                        % (target, "; ".join(counted) or "no element count", len(inverted),
                           ("; " + "; ".join(errors[:5])) if errors else ""))
+
+    # The other way round: what meshio writes (VTU with inline binary data, zlib-compressed,
+    # its default, and uncompressed; ASCII) our reader takes.
+    import meshio
+    source = meshio.read(os.path.join(meshes_dir, "rockerarm.mesh"))
+    for binary, compression in ((True, "zlib"), (True, None), (False, None)):
+        target = os.path.join(tmp, "meshio_%s_%s.vtu" % ("binary" if binary else "ascii", compression))
+        try:
+            meshio.write(target, source, binary=binary, compression=compression)
+        except TypeError:  # older meshio without the compression keyword
+            meshio.write(target, source, binary=binary)
+        code, out = run([exe, "check", target])
+        report(code == 0 and "10600 hexes" in out,
+               "hexrefine check reads meshio's %s: %s" % (os.path.basename(target), out.splitlines()[0] if out else ""))
 
     print("%d passed, %d failed" % (passed, failed))
     return 0 if failed == 0 else 1

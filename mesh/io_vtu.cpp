@@ -1,0 +1,493 @@
+/// \file
+/// VTK XML unstructured grids (.vtu): written with appended raw binary data (zlib-compressed on
+/// request) or ASCII; read in every encoding ParaView and meshio write (ascii, inline binary,
+/// appended raw or base64; zlib or not; io_vtu_data.hpp). VTK_HEXAHEDRON (12) is hexrefine's
+/// order; VTK_VOXEL (11) is read with its nodes 2/3 and 6/7 swapped.
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <type_traits>
+
+#include "mesh/atomic_file.hpp"
+#include "mesh/io.hpp"
+#include "mesh/io_text.hpp"
+#include "mesh/io_vtk_common.hpp"
+#include "mesh/io_vtu_data.hpp"
+
+namespace hexrefine::io_detail {
+
+namespace {
+
+/// The binary VTU: every array in <AppendedData encoding="raw">, each a block (UInt64 byte
+/// count, then the little-endian values; zlib blocks with `compress`). Connectivity and offsets
+/// are Int32 while the offsets fit (8 x hexes <= 2^31 - 1), else Int64.
+void vtu_write_appended(std::ostream& out, const HexMesh& mesh,
+                        const std::vector<std::pair<std::string, std::vector<double>>>& scalars,
+                        bool compress) {
+  static_assert(std::endian::native == std::endian::little, "the VTU writer assumes little-endian");
+  const size_t n = mesh.points.size(), m = mesh.hexes.size();
+  const bool wide = 8 * static_cast<uint64_t>(m) > static_cast<uint64_t>(INT32_MAX);
+  std::vector<uint8_t> types(m, 12);
+  std::vector<int64_t> offsets64;
+  std::vector<int32_t> offsets32;
+  std::vector<int64_t> connectivity64;
+  if (wide) {
+    offsets64.resize(m);
+    connectivity64.resize(8 * m);
+    for (size_t h = 0; h < m; ++h) {
+      offsets64[h] = 8 * static_cast<int64_t>(h + 1);
+      for (int k = 0; k < 8; ++k) connectivity64[8 * h + k] = mesh.hexes[h][k];
+    }
+  } else {
+    offsets32.resize(m);
+    for (size_t h = 0; h < m; ++h) offsets32[h] = 8 * static_cast<int32_t>(h + 1);
+  }
+  // The arrays in file order: their XML before the offset, data, bytes. HexCell is 8 packed
+  // int32 and a point 3 packed doubles, so both are written straight from the mesh.
+  static_assert(sizeof(HexCell) == 32 && sizeof(Eigen::Vector3d) == 24);
+  struct Array {
+    std::string xml;
+    const void* data;
+    size_t bytes;
+  };
+  const std::string index = wide ? "Int64" : "Int32";
+  std::vector<Array> arrays = {
+      {"<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\"", mesh.points.data(),
+       24 * n},
+      {"</Points>\n<Cells>\n<DataArray type=\"" + index + "\" Name=\"connectivity\"",
+       wide ? static_cast<const void*>(connectivity64.data()) : mesh.hexes.data(),
+       (wide ? 64 : 32) * m},
+      {"<DataArray type=\"" + index + "\" Name=\"offsets\"",
+       wide ? static_cast<const void*>(offsets64.data()) : offsets32.data(), (wide ? 8 : 4) * m},
+      {"<DataArray type=\"UInt8\" Name=\"types\"", types.data(), m}};
+  const bool cell_data = !mesh.attributes.empty() || !scalars.empty();
+  for (size_t i = 0; i < mesh.attributes.size(); ++i)
+    arrays.push_back({std::string(i == 0 ? "</Cells>\n<CellData>\n" : "") +
+                          "<DataArray type=\"Int32\" Name=\"" + mesh.attributes[i].name + "\"",
+                      mesh.attributes[i].values.data(), 4 * m});
+  for (size_t i = 0; i < scalars.size(); ++i)
+    arrays.push_back(
+        {std::string(i == 0 && mesh.attributes.empty() ? "</Cells>\n<CellData>\n" : "") +
+             "<DataArray type=\"Float64\" Name=\"" + scalars[i].first + "\"",
+         scalars[i].second.data(), 8 * m});
+  std::vector<std::string> compressed;
+  if (compress)
+    for (const Array& a : arrays) compressed.push_back(vtu_block_compress(a.data, a.bytes));
+  std::string xml =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+      "byte_order=\"LittleEndian\" header_type=\"UInt64\"";
+  if (compress) xml += " compressor=\"vtkZLibDataCompressor\"";
+  xml += ">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"" + std::to_string(n) +
+         "\" NumberOfCells=\"" + std::to_string(m) + "\">\n";
+  uint64_t offset = 0;
+  for (size_t i = 0; i < arrays.size(); ++i) {
+    xml += arrays[i].xml + " format=\"appended\" offset=\"" + std::to_string(offset) + "\"/>\n";
+    offset += compress ? compressed[i].size() : 8 + arrays[i].bytes;
+  }
+  xml += cell_data ? "</CellData>\n" : "</Cells>\n";
+  xml += "</Piece>\n</UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_";
+  out.write(xml.data(), static_cast<std::streamsize>(xml.size()));
+  for (size_t i = 0; i < arrays.size(); ++i) {
+    if (compress) {
+      out.write(compressed[i].data(), static_cast<std::streamsize>(compressed[i].size()));
+      continue;
+    }
+    const uint64_t bytes = arrays[i].bytes;
+    out.write(reinterpret_cast<const char*>(&bytes), 8);
+    out.write(static_cast<const char*>(arrays[i].data), static_cast<std::streamsize>(bytes));
+  }
+  const std::string tail = "\n</AppendedData>\n</VTKFile>\n";
+  out.write(tail.data(), static_cast<std::streamsize>(tail.size()));
+}
+
+}  // namespace
+
+void vtu_write(const std::string& path, const HexMesh& mesh,
+               const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars,
+               bool ascii, bool compress) {
+  if (!ascii) {
+    file_write_atomically(
+        path, [&](std::ostream& out) { vtu_write_appended(out, mesh, cell_scalars, compress); });
+    return;
+  }
+  file_write_atomically(path, [&](std::ostream& out) {
+    TextWriter w(out);
+    const size_t n = mesh.points.size(), m = mesh.hexes.size();
+    w.text("<?xml version=\"1.0\"?>\n");
+    w.text(
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+        "header_type=\"UInt64\">\n<UnstructuredGrid>\n");
+    w.text("<Piece NumberOfPoints=\"").integer(static_cast<int64_t>(n));
+    w.text("\" NumberOfCells=\"").integer(static_cast<int64_t>(m)).text("\">\n");
+    w.text("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (const Eigen::Vector3d& p : mesh.points)
+      w.real(p.x()).put(' ').real(p.y()).put(' ').real(p.z()).put('\n');
+    w.text("</DataArray>\n</Points>\n<Cells>\n");
+    w.text("<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
+    for (const HexCell& c : mesh.hexes) {
+      for (int k = 0; k < 8; ++k) w.integer(c[k]).put(k < 7 ? ' ' : '\n');
+    }
+    w.text("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+    for (size_t h = 0; h < m; ++h) w.integer(8 * (static_cast<int64_t>(h) + 1)).put('\n');
+    w.text("</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
+    for (size_t h = 0; h < m; ++h) w.text("12\n");
+    w.text("</DataArray>\n</Cells>\n");
+    if (!mesh.attributes.empty() || !cell_scalars.empty()) {
+      w.text("<CellData>\n");
+      for (const HexAttribute& a : mesh.attributes) {
+        w.text("<DataArray type=\"Int32\" Name=\"").text(a.name).text("\" format=\"ascii\">\n");
+        for (int32_t v : a.values) w.integer(v).put('\n');
+        w.text("</DataArray>\n");
+      }
+      for (const auto& [name, values] : cell_scalars) {
+        w.text("<DataArray type=\"Float64\" Name=\"").text(name).text("\" format=\"ascii\">\n");
+        for (double v : values) w.real(v).put('\n');
+        w.text("</DataArray>\n");
+      }
+      w.text("</CellData>\n");
+    }
+    w.text("</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    w.flush();
+  });
+}
+
+}  // namespace hexrefine::io_detail
+
+namespace hexrefine::io_detail {
+
+namespace {
+
+/// Value of attribute `name` inside the tag text `tag` ("" if absent).
+std::string xml_attribute(std::string_view tag, std::string_view name) {
+  size_t p = 0;
+  while ((p = tag.find(name, p)) != std::string_view::npos) {
+    const bool starts = p > 0 && (tag[p - 1] == ' ' || tag[p - 1] == '\n' || tag[p - 1] == '\t' ||
+                                  tag[p - 1] == '\r');
+    size_t q = p + name.size();
+    while (q < tag.size() && tag[q] == ' ') ++q;
+    if (starts && q < tag.size() && tag[q] == '=') {
+      ++q;
+      while (q < tag.size() && tag[q] == ' ') ++q;
+      if (q < tag.size() && (tag[q] == '"' || tag[q] == '\'')) {
+        const size_t end = tag.find(tag[q], q + 1);
+        if (end == std::string_view::npos) return "";
+        return std::string(tag.substr(q + 1, end - q - 1));
+      }
+    }
+    p += name.size();
+  }
+  return "";
+}
+
+/// Calls f(value as double, value as int64) for each of the `count` little-endian values of
+/// VTK type `type` (legacy name) in `bytes`; InputError naming `what` if the sizes differ.
+template <class F>
+void vtu_binary_values(const std::string& path, std::string_view bytes, std::string_view type,
+                       int64_t count, const std::string& what, F f) {
+  const int size = vtk_type_size(type);
+  if (size <= 0 || count < 0 || static_cast<int64_t>(bytes.size()) != count * size)
+    throw InputError(path + ": " + what + ": " + std::to_string(bytes.size()) +
+                     " bytes of data, expected " + std::to_string(count) + " values of " +
+                     std::to_string(size) + " bytes");
+  auto each = [&](auto zero) {
+    using T = decltype(zero);
+    for (int64_t i = 0; i < count; ++i) {
+      T v;
+      std::memcpy(&v, bytes.data() + i * static_cast<int64_t>(sizeof(T)), sizeof(T));
+      if constexpr (std::is_floating_point_v<T>) {
+        f(static_cast<double>(v), 0);
+      } else {
+        if constexpr (std::is_same_v<T, uint64_t>)
+          if (v > static_cast<uint64_t>(INT64_MAX))
+            throw InputError(path + ": " + what + ": value " + std::to_string(v) + " too large");
+        f(static_cast<double>(v), static_cast<int64_t>(v));
+      }
+    }
+  };
+  if (type == "char")
+    each(int8_t{});
+  else if (type == "unsigned_char")
+    each(uint8_t{});
+  else if (type == "short")
+    each(int16_t{});
+  else if (type == "unsigned_short")
+    each(uint16_t{});
+  else if (type == "int")
+    each(int32_t{});
+  else if (type == "unsigned_int")
+    each(uint32_t{});
+  else if (type == "long")
+    each(int64_t{});
+  else if (type == "unsigned_long")
+    each(uint64_t{});
+  else if (type == "float")
+    each(float{});
+  else
+    each(double{});
+}
+
+int64_t line_of(std::string_view text, size_t pos) {
+  int64_t line = 1;
+  for (size_t i = 0; i < pos && i < text.size(); ++i)
+    if (text[i] == '\n') ++line;
+  return line;
+}
+
+}  // namespace
+
+HexMesh vtu_read(const std::string& path, const std::string& text) {
+  const std::string_view all(text);
+  auto fail_at = [&](size_t pos, const std::string& message) -> void {
+    throw InputError(error_at(path, line_of(all, pos), message));
+  };
+  if (all.find("<VTKFile") == std::string_view::npos ||
+      xml_attribute(all.substr(all.find("<VTKFile"), 300), "type") != "UnstructuredGrid")
+    fail_at(0, "expected a VTK XML file <VTKFile type=\"UnstructuredGrid\" ...>");
+  // The binary encodings (io_vtu_data.hpp): header integers, compressor, appended data.
+  const size_t file_tag = all.find("<VTKFile");
+  const std::string_view file_tag_text = all.substr(file_tag, all.find('>', file_tag) - file_tag);
+  const std::string byte_order = xml_attribute(file_tag_text, "byte_order");
+  if (!byte_order.empty() && byte_order != "LittleEndian")
+    fail_at(file_tag, "byte_order=\"" + byte_order + "\": only LittleEndian data is read");
+  const std::string header_type = xml_attribute(file_tag_text, "header_type");
+  if (!header_type.empty() && header_type != "UInt32" && header_type != "UInt64")
+    fail_at(file_tag, "header_type=\"" + header_type + "\": expected UInt32 or UInt64");
+  const std::string compressor = xml_attribute(file_tag_text, "compressor");
+  if (!compressor.empty() && compressor != "vtkZLibDataCompressor")
+    fail_at(file_tag, "compressor=\"" + compressor +
+                          "\": only vtkZLibDataCompressor (zlib) compressed data is read");
+  const VtuBlockFormat block_format{header_type == "UInt64" ? 8 : 4, !compressor.empty()};
+  // Appended data starts after the '_' that ends the XML part; XML is searched before it only.
+  const size_t appended = all.find("<AppendedData");
+  size_t appended_start = std::string_view::npos;
+  bool appended_base64 = false;
+  if (appended != std::string_view::npos) {
+    const size_t tag_close = all.find('>', appended);
+    if (tag_close == std::string_view::npos) fail_at(appended, "unterminated <AppendedData> tag");
+    const std::string encoding =
+        xml_attribute(all.substr(appended, tag_close - appended), "encoding");
+    if (encoding != "raw" && encoding != "base64")
+      fail_at(appended, "<AppendedData encoding=\"" + encoding + "\">: expected raw or base64");
+    appended_base64 = encoding == "base64";
+    appended_start = all.find('_', tag_close);
+    if (appended_start == std::string_view::npos)
+      fail_at(appended, "<AppendedData> without its '_' marker");
+    ++appended_start;
+  }
+  const std::string_view xml = all.substr(0, appended);
+  const size_t piece = xml.find("<Piece");
+  if (piece == std::string_view::npos) fail_at(0, "no <Piece> element");
+  if (xml.find("<Piece", piece + 1) != std::string_view::npos)
+    fail_at(xml.find("<Piece", piece + 1), "more than one <Piece> is not supported");
+  const size_t piece_end = all.find('>', piece);
+  if (piece_end == std::string_view::npos) fail_at(piece, "unterminated <Piece> tag");
+  const std::string_view piece_tag = all.substr(piece, piece_end - piece);
+  int64_t np = -1, nc = -1;
+  if (!TextCursor::parse_integer(xml_attribute(piece_tag, "NumberOfPoints"), np) || np < 0 ||
+      !TextCursor::parse_integer(xml_attribute(piece_tag, "NumberOfCells"), nc) || nc < 0)
+    fail_at(piece, "<Piece> needs NumberOfPoints and NumberOfCells >= 0");
+  const int64_t size = static_cast<int64_t>(text.size());
+  if (np > size / 6 || nc > size / 6)
+    fail_at(piece, "NumberOfPoints/NumberOfCells larger than the file (" + std::to_string(size) +
+                       " bytes) can hold");
+
+  VtkReadState st;
+  std::vector<int64_t> connectivity, offsets, types;
+  bool have_points = false;
+  struct Pending {
+    std::string name;
+    size_t begin;
+    int64_t line;
+    std::string type;
+    std::string bytes;  ///< the decoded values of a binary array
+    bool binary = false;
+  };
+  std::vector<Pending> cell_arrays;
+  // Section openings and line numbers are followed forward from one array to the next, so the
+  // file is scanned once in all, not once per array.
+  constexpr std::string_view section_names[4] = {"<Points", "<Cells", "<CellData", "<PointData"};
+  int64_t section_at[4] = {-1, -1, -1, -1};  // last opening of each before `scanned`
+  size_t scanned = 0;
+  size_t line_pos = 0;  // line_no is the line of offset line_pos
+  int64_t line_no = 1;
+  auto line_at = [&](size_t pos) {
+    if (pos < line_pos) return line_of(all, pos);
+    line_no += std::count(all.begin() + static_cast<ptrdiff_t>(line_pos),
+                          all.begin() + static_cast<ptrdiff_t>(pos), '\n');
+    line_pos = pos;
+    return line_no;
+  };
+  size_t p = piece_end;
+  while ((p = xml.find("<DataArray", p)) != std::string_view::npos) {
+    const size_t tag_end = xml.find('>', p);
+    if (tag_end == std::string_view::npos) fail_at(p, "unterminated <DataArray> tag");
+    const std::string_view tag = all.substr(p, tag_end - p);
+    const bool self_closing = !tag.empty() && tag.back() == '/';
+    const size_t close = self_closing ? tag_end : xml.find("</DataArray>", tag_end);
+    if (close == std::string_view::npos) fail_at(p, "<DataArray> without </DataArray>");
+    const std::string name = xml_attribute(tag, "Name");
+    const std::string format = xml_attribute(tag, "format");
+    std::string type = xml_attribute(tag, "type");
+    const std::string comps = xml_attribute(tag, "NumberOfComponents");
+    // Which section holds this array: the nearest section opening before it. (No opening can
+    // straddle p: the names hold '<' only first, and p is the '<' of "<DataArray".)
+    const std::string_view before = all.substr(0, p);
+    for (int k = 0; k < 4; ++k)
+      for (size_t q = scanned; (q = before.find(section_names[k], q)) != std::string_view::npos;
+           ++q)
+        section_at[k] = static_cast<int64_t>(q);
+    scanned = p;
+    const int64_t in_points = section_at[0], in_cells = section_at[1], in_cell_data = section_at[2],
+                  in_point_data = section_at[3];
+    const int64_t section = std::max({in_points, in_cells, in_cell_data, in_point_data});
+    if (format != "ascii" && format != "binary" && format != "appended")
+      fail_at(p, "DataArray '" + name + "' has format \"" + format +
+                     "\": expected ascii, binary or appended");
+    // The values end at the first nested element (VTK writes <InformationKey> after them).
+    const size_t values_end = self_closing ? tag_end : std::min(close, all.find('<', tag_end + 1));
+    const bool binary = format != "ascii";
+    std::string bytes;  // a binary array's decoded values
+    if (format == "binary") {
+      bytes = vtu_block_decode_base64(all.substr(tag_end + 1, values_end - tag_end - 1),
+                                      block_format, path, tag_end + 1);
+    } else if (format == "appended") {
+      int64_t offset = -1;
+      if (appended_start == std::string_view::npos ||
+          !TextCursor::parse_integer(xml_attribute(tag, "offset"), offset) || offset < 0 ||
+          static_cast<uint64_t>(offset) > all.size() - appended_start)
+        fail_at(p, "appended DataArray '" + name +
+                       "' needs an offset inside <AppendedData> (offset=\"" +
+                       xml_attribute(tag, "offset") + "\")");
+      const size_t at = appended_start + static_cast<size_t>(offset);
+      if (appended_base64) {
+        const size_t length = vtu_block_base64_length(all.substr(at), block_format, path, at);
+        bytes = vtu_block_decode_base64(all.substr(at, length), block_format, path, at);
+      } else {
+        bytes = vtu_block_decode_raw(all.substr(at), block_format, path, at, nullptr);
+      }
+    }
+    TextCursor in(path, all.substr(tag_end + 1, values_end - tag_end - 1));
+    in.set_line(line_at(tag_end + 1));
+    const std::string what = "values of DataArray '" + name + "'";
+    static const std::pair<const char*, const char*> type_names[] = {
+        {"Int8", "char"},     {"UInt8", "unsigned_char"},
+        {"Int16", "short"},   {"UInt16", "unsigned_short"},
+        {"Int32", "int"},     {"UInt32", "unsigned_int"},
+        {"Int64", "long"},    {"UInt64", "unsigned_long"},
+        {"Float32", "float"}, {"Float64", "double"}};
+    std::string legacy_type;
+    for (const auto& [x, l] : type_names)
+      if (type == x) legacy_type = l;
+    if (legacy_type.empty()) fail_at(p, "DataArray '" + name + "' has unknown type '" + type + "'");
+    if (section == in_points && section >= 0) {
+      if (comps != "3") fail_at(p, "Points DataArray needs NumberOfComponents=\"3\"");
+      st.mesh.points.resize(static_cast<size_t>(np));
+      int64_t i = 0;
+      auto store = [&](double d, int64_t v) {
+        st.mesh.points[i / 3][i % 3] =
+            vtk_type_is_integer(legacy_type) ? static_cast<double>(v) : d;
+        ++i;
+      };
+      if (binary)
+        vtu_binary_values(path, bytes, legacy_type, 3 * np, "point coordinates",
+                          [&](double d, int64_t v) {
+                            if (!std::isfinite(d))
+                              throw InputError(path + ": point " + std::to_string(i / 3) +
+                                               " has a NaN or infinite coordinate");
+                            store(d, v);
+                          });
+      else
+        vtk_read_values(in, false, legacy_type, 3 * np, "point coordinate", false, store);
+      have_points = true;
+    } else if (section == in_cells && section >= 0) {
+      std::vector<int64_t>* out = name == "connectivity" ? &connectivity
+                                  : name == "offsets"    ? &offsets
+                                  : name == "types"      ? &types
+                                                         : nullptr;
+      if (out == nullptr) fail_at(p, "unknown Cells DataArray '" + name + "'");
+      if (binary) {
+        const int value_size = vtk_type_size(legacy_type);
+        if (value_size <= 0 || bytes.size() % static_cast<size_t>(value_size) != 0)
+          fail_at(p, what + ": " + std::to_string(bytes.size()) + " bytes, not whole values");
+        out->reserve(bytes.size() / static_cast<size_t>(value_size));
+        vtu_binary_values(path, bytes, legacy_type, static_cast<int64_t>(bytes.size()) / value_size,
+                          what, [&](double, int64_t v) { out->push_back(v); });
+      }
+      while (!binary && !in.at_end()) {
+        if (out->size() >= static_cast<size_t>(size)) in.fail("too many values");
+        out->push_back(in.integer(what));
+      }
+    } else if (section == in_cell_data && section >= 0) {
+      cell_arrays.push_back({name, tag_end + 1, in.line(), legacy_type, std::move(bytes), binary});
+      if (comps != "" && comps != "1") cell_arrays.back().type = "";  // multi-component: skipped
+    }
+    if (!binary && section >= 0 && !in.at_end() && (section == in_points || section == in_cells))
+      in.fail("more values than expected in " + what);
+    p = close;
+  }
+  if (!have_points) fail_at(piece, "no <Points> DataArray");
+  if (static_cast<int64_t>(offsets.size()) != nc || static_cast<int64_t>(types.size()) != nc)
+    fail_at(piece, "Cells offsets/types need NumberOfCells = " + std::to_string(nc) + " values");
+  st.hex_of_cell.assign(static_cast<size_t>(nc), -1);
+  int64_t start = 0;
+  for (int64_t c = 0; c < nc; ++c) {
+    const int64_t end = offsets[c];
+    if (end < start || end > static_cast<int64_t>(connectivity.size()))
+      fail_at(piece,
+              "cell " + std::to_string(c) + ": offsets not increasing or beyond the connectivity");
+    const int kind = vtk_cell_kind(types[c]);
+    if (kind == -1)
+      fail_at(piece,
+              "cell " + std::to_string(c) + " has VTK type " + std::to_string(types[c]) +
+                  ", a volume cell that is not a linear hexahedron (only hexes are supported)");
+    if (kind == -2)
+      fail_at(piece,
+              "cell " + std::to_string(c) + " has unknown VTK type " + std::to_string(types[c]));
+    if (kind == 1) {
+      if (end - start != 8)
+        fail_at(piece, "hexahedron " + std::to_string(c) + " has " + std::to_string(end - start) +
+                           " nodes, expected 8");
+      HexCell h;
+      for (int k = 0; k < 8; ++k) {
+        const int64_t v = connectivity[start + k];
+        if (v < 0 || v >= np)
+          fail_at(piece, "cell " + std::to_string(c) + " refers to point " + std::to_string(v) +
+                             ", expected 0.." + std::to_string(np - 1));
+        h[k] = static_cast<int32_t>(v);
+      }
+      if (types[c] == 11) std::swap(h[2], h[3]), std::swap(h[6], h[7]);
+      st.hex_of_cell[c] = static_cast<int32_t>(st.mesh.hexes.size());
+      st.mesh.hexes.push_back(h);
+    }
+    start = end;
+  }
+  for (const Pending& a : cell_arrays) {
+    if (a.type.empty() || !vtk_type_is_integer(a.type) || a.name.empty() ||
+        mesh_find_attribute(st.mesh, a.name))
+      continue;
+    if (a.binary) {
+      std::vector<int32_t> values(st.mesh.hexes.size());
+      int64_t i = 0;
+      const std::string what = "DataArray '" + a.name + "'";
+      vtu_binary_values(path, a.bytes, a.type, nc, what, [&](double, int64_t v) {
+        if (v < INT32_MIN || v > INT32_MAX)
+          throw InputError(path + ": " + what + ": " + std::to_string(v) + " exceeds int32");
+        const int32_t h = st.hex_of_cell[i++];
+        if (h >= 0) values[h] = static_cast<int32_t>(v);
+      });
+      st.mesh.attributes.push_back({a.name, std::move(values)});
+      continue;
+    }
+    const size_t close = std::min(all.find("</DataArray>", a.begin), all.find('<', a.begin));
+    TextCursor in(path, all.substr(a.begin, close - a.begin));
+    in.set_line(a.line);
+    vtk_read_array(in, false, st, true, a.name, a.type, 1, nc);
+    if (!in.at_end()) in.fail("more than NumberOfCells values in DataArray '" + a.name + "'");
+  }
+  mesh_check_read(st.mesh, path);
+  return std::move(st.mesh);
+}
+
+}  // namespace hexrefine::io_detail

@@ -1,0 +1,157 @@
+#include "mesh/io_vtu_data.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "cli_runner.hpp"
+#include "io_test_support.hpp"
+#include "mesh/error.hpp"
+#include "mesh/io.hpp"
+
+namespace hexrefine {
+namespace {
+
+using io_detail::base64_encode;
+using io_detail::VtuBlockFormat;
+
+/// `size` as a little-endian header integer of `bytes` bytes.
+std::string header(uint64_t size, int bytes) {
+  std::string out(static_cast<size_t>(bytes), '\0');
+  std::memcpy(out.data(), &size, static_cast<size_t>(bytes));
+  return out;
+}
+
+/// One hex (unit cube) as a VTU whose five arrays are written by `array(type, name, data)`.
+template <class Array>
+std::string unit_cube_vtu(const std::string& file_attributes, Array array,
+                          const std::string& appended = "") {
+  double points[24] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+  int32_t connectivity[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  int64_t offsets[1] = {8};
+  uint8_t types[1] = {12};
+  int32_t block[1] = {7};
+  auto bytes = [](const void* p, size_t n) { return std::string(static_cast<const char*>(p), n); };
+  std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" " +
+                  file_attributes +
+                  ">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"8\" "
+                  "NumberOfCells=\"1\">\n<Points>\n" +
+                  array("Float64\" NumberOfComponents=\"3", "Points", bytes(points, 192)) +
+                  "</Points>\n<Cells>\n" + array("Int32", "connectivity", bytes(connectivity, 32)) +
+                  array("Int64", "offsets", bytes(offsets, 8)) +
+                  array("UInt8", "types", bytes(types, 1)) + "</Cells>\n<CellData>\n" +
+                  array("Int32", "block_id", bytes(block, 4)) +
+                  "</CellData>\n</Piece>\n</UnstructuredGrid>\n" + appended + "</VTKFile>\n";
+  return s;
+}
+
+void expect_unit_cube(const HexMesh& m) {
+  ASSERT_EQ(m.hex_count(), 1);
+  EXPECT_EQ(m.hexes[0], (HexCell{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(m.points[6], Eigen::Vector3d(1, 1, 1));
+  EXPECT_EQ(*mesh_find_attribute(m, attribute_block_id), std::vector<int32_t>{7});
+}
+
+TEST(IoVtuData, Base64MatchesRfc4648) {
+  EXPECT_EQ(base64_encode(""), "");
+  EXPECT_EQ(base64_encode("f"), "Zg==");
+  EXPECT_EQ(base64_encode("fo"), "Zm8=");
+  EXPECT_EQ(base64_encode("foobar"), "Zm9vYmFy");
+}
+
+TEST(IoVtuData, InlineBinaryWithHeaderAndDataEncodedSeparatelyOrTogether) {
+  const auto dir = test_temp_dir("io_vtu_inline");
+  for (int header_bytes : {4, 8})
+    for (bool together : {false, true}) {
+      SCOPED_TRACE(std::to_string(header_bytes) + (together ? " together" : " separate"));
+      auto array = [&](const std::string& type, const std::string& name, const std::string& d) {
+        const std::string h = header(d.size(), header_bytes);
+        const std::string encoded =
+            together ? base64_encode(h + d) : base64_encode(h) + base64_encode(d);
+        return "<DataArray type=\"" + type + "\" Name=\"" + name + "\" format=\"binary\">\n  " +
+               encoded + "\n</DataArray>\n";
+      };
+      const std::string type = header_bytes == 4 ? "UInt32" : "UInt64";
+      const auto p =
+          dir / ("cube" + std::to_string(header_bytes) + (together ? "t" : "s") + ".vtu");
+      io_write_text(p, unit_cube_vtu("header_type=\"" + type + "\"", array));
+      expect_unit_cube(mesh_read(p.string()));
+    }
+}
+
+TEST(IoVtuData, AppendedRawAndBase64WithAndWithoutZlib) {
+  const auto dir = test_temp_dir("io_vtu_appended");
+  for (bool zlib : {false, true})
+    for (bool base64 : {false, true}) {
+      SCOPED_TRACE(std::string(zlib ? "zlib" : "plain") + (base64 ? " base64" : " raw"));
+      std::string data;
+      auto array = [&](const std::string& type, const std::string& name, const std::string& d) {
+        const std::string offset = std::to_string(data.size());
+        std::string block =
+            zlib ? io_detail::vtu_block_compress(d.data(), d.size()) : header(d.size(), 8) + d;
+        if (base64 && zlib) {
+          // Header (3 + blocks integers) and compressed data encoded separately, as VTK does.
+          uint64_t blocks = 0;
+          std::memcpy(&blocks, block.data(), 8);
+          const size_t h = (3 + blocks) * 8;
+          block = base64_encode(block.substr(0, h)) + base64_encode(block.substr(h));
+        } else if (base64) {
+          block = base64_encode(block.substr(0, 8)) + base64_encode(block.substr(8));
+        }
+        data += block;
+        return "<DataArray type=\"" + type + "\" Name=\"" + name +
+               "\" format=\"appended\" offset=\"" + offset + "\"/>\n";
+      };
+      const std::string attributes =
+          std::string("header_type=\"UInt64\" byte_order=\"LittleEndian\"") +
+          (zlib ? " compressor=\"vtkZLibDataCompressor\"" : "");
+      // The arrays must be made before the appended section that holds them.
+      std::string text = unit_cube_vtu(attributes, array);
+      const std::string appended = std::string("<AppendedData encoding=\"") +
+                                   (base64 ? "base64" : "raw") + "\">\n  _" + data +
+                                   "\n</AppendedData>\n";
+      text.insert(text.rfind("</VTKFile>"), appended);
+      const auto p =
+          dir / (std::string("cube") + (zlib ? "z" : "p") + (base64 ? "b" : "r") + ".vtu");
+      io_write_text(p, text);
+      expect_unit_cube(mesh_read(p.string()));
+    }
+}
+
+TEST(IoVtuData, TruncatedOrForeignBinaryIsRefusedWithFileAndByte) {
+  const auto dir = test_temp_dir("io_vtu_bad");
+  const HexMesh m = io_test_brick();
+  const std::string path = (dir / "good.vtu").string();
+  mesh_write(path, m);
+  std::ifstream in(path, std::ios::binary);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const auto cut = dir / "cut.vtu";
+  io_write_text(cut, text.substr(0, text.size() * 2 / 3));
+  try {
+    mesh_read(cut.string());
+    FAIL() << "truncated VTU accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.vtu: byte "), std::string::npos) << e.what();
+  }
+  std::string big = text;
+  big.replace(big.find("LittleEndian"), 12, "BigEndian");
+  const auto be = dir / "big.vtu";
+  io_write_text(be, big);
+  EXPECT_THROW(mesh_read(be.string()), InputError);
+  std::string lz4 = text;
+  lz4.replace(lz4.find("header_type"), 0, "compressor=\"vtkLZ4DataCompressor\" ");
+  const auto l = dir / "lz4.vtu";
+  io_write_text(l, lz4);
+  try {
+    mesh_read(l.string());
+    FAIL() << "lz4 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("vtkLZ4DataCompressor"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace hexrefine

@@ -60,6 +60,9 @@ struct RunPlan {
 RunPlan run_plan_parse(const nlohmann::json& root, const std::string& file,
                        const std::string& base_dir);
 
+/// The bytes of the file at `path`; InputError naming it if it cannot be read.
+std::string run_file_read(const std::string& path);
+
 /// Reads and parses a case file (syntax errors: InputError with the file, line and column).
 RunPlan run_plan_read(const std::string& path);
 

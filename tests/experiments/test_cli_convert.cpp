@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
 
 #include "cli_runner.hpp"
 #include "mesh/io.hpp"
@@ -51,6 +52,26 @@ TEST(CliConvert, VtkOutputCarriesScaledJacobian) {
   int bad = 0;
   for (double q : written) bad += q <= 0;
   EXPECT_EQ(bad, 76);  // the README: 76 of its hexes are inverted or degenerate
+}
+
+TEST(CliConvert, VtuEncodingSwitches) {
+  const auto dir = test_temp_dir("cli_convert_vtu");
+  const std::string in = shared_mesh("rockerarm.mesh");
+  const std::string zlib = (dir / "z.vtu").string(), text = (dir / "t.vtu").string();
+  ASSERT_EQ(cli_run("convert " + in + " " + zlib + " --compress").exit_code, 0);
+  ASSERT_EQ(cli_run("convert " + in + " " + text + " --ascii").exit_code, 0);
+  std::ifstream z(zlib, std::ios::binary), t(text, std::ios::binary);
+  const std::string zs{std::istreambuf_iterator<char>(z), std::istreambuf_iterator<char>()};
+  const std::string ts{std::istreambuf_iterator<char>(t), std::istreambuf_iterator<char>()};
+  EXPECT_NE(zs.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos);
+  EXPECT_NE(ts.find("format=\"ascii\""), std::string::npos);
+  EXPECT_EQ(mesh_read(zlib).hex_count(), 10600);
+  EXPECT_EQ(mesh_read(text).hex_count(), 10600);
+  // The switches belong to their formats and exclude each other.
+  const CliRun wrong = cli_run("convert " + in + " " + (dir / "x.vtk").string() + " --compress");
+  EXPECT_EQ(wrong.exit_code, 2);
+  EXPECT_NE(wrong.output.find(".vtu output only"), std::string::npos) << wrong.output;
+  EXPECT_EQ(cli_run("convert " + in + " " + zlib + " --ascii --compress").exit_code, 2);
 }
 
 TEST(CliConvert, BadInputExitsTwoNamingTheFile) {

@@ -34,7 +34,12 @@ double process_cpu_seconds() {
 /// Ends a stage: its wall and CPU time go to the result and, with --verbose, to the stream.
 class StageClock {
  public:
-  StageClock(PipelineResult& result, std::ostream* verbose) : result_(result), verbose_(verbose) {}
+  StageClock(PipelineResult& result, std::ostream* verbose, std::ostream* progress = nullptr)
+      : result_(result), verbose_(verbose), progress_(progress) {}
+  /// Names the stage that starts on the progress stream (one line, overwritten by the next).
+  void begin(const std::string& stage) {
+    if (progress_) *progress_ << "\rhexrefine: " << stage << " ...\033[K" << std::flush;
+  }
   void end(const std::string& stage) {
     const double s = seconds_since(start_);
     const double cpu = process_cpu_seconds();
@@ -43,6 +48,7 @@ class StageClock {
     if (verbose_)
       *verbose_ << "hexrefine: " << stage << " " << std::fixed << std::setprecision(3) << s << " s"
                 << std::endl;
+    if (progress_) *progress_ << "\r\033[K" << std::flush;
     start_ = Clock::now();
     cpu_start_ = cpu;
   }
@@ -50,6 +56,7 @@ class StageClock {
  private:
   PipelineResult& result_;
   std::ostream* verbose_;
+  std::ostream* progress_;
   Clock::time_point start_ = Clock::now();
   double cpu_start_ = process_cpu_seconds();
 };
@@ -121,7 +128,8 @@ double process_peak_memory_mb() {
 PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
   const auto start = Clock::now();
   PipelineResult r;
-  StageClock clock(r, o.verbose);
+  StageClock clock(r, o.verbose, o.progress);
+  clock.begin("select");
   const RefineMethod& method = refine_method(o.method);
   r.ablation = !o.refine.ranking || !o.refine.propagation || o.refine.ebe_only;
 
@@ -133,6 +141,7 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
     r.selection_warning = std::move(selection.warning);
   }
   clock.end("select");
+  clock.begin("refine");
 
   size_bound_check(input, o);
   if (r.selected.empty()) {
@@ -150,6 +159,7 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
     r.stats = std::move(refined.stats);
   }
   clock.end("refine");
+  clock.begin("check");
   {
     // A refined parent's children are a level above it (the input's own levels, if any, kept).
     const std::vector<int32_t>* parent = mesh_find_attribute(r.mesh, attribute_parent_hex);
@@ -183,8 +193,10 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
           boundary_reference_build(input, topology_build(input, TopologyParts::faces));
       so.reference = &reference;
       so.reference_nodes = input.point_count();
+      clock.begin("smooth");
       r.smoothing = mesh_smooth(r.mesh, so);
       clock.end("smooth");
+      clock.begin("check (smoothed)");
       r.smoothed_check = mesh_check(r.mesh, &input, o.refine.threads);
       clock.end("check_smoothed");
       verdict_enforce(*r.smoothed_check, r.mesh, input, o, r.ablation, "smoothing");
@@ -199,7 +211,8 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
                                   const PipelineOptions& options) {
   const auto start = Clock::now();
   PipelineResult scratch;
-  StageClock clock(scratch, options.verbose);
+  StageClock clock(scratch, options.verbose, options.progress);
+  clock.begin("read");
   const HexMesh input = mesh_read(in);
   clock.end("read");
   PipelineResult r;
@@ -209,7 +222,8 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
     throw InputError(in + ": " + e.what());  // the input, or a spec applied to it
   }
   if (!out.empty()) {
-    StageClock write_clock(r, options.verbose);
+    StageClock write_clock(r, options.verbose, options.progress);
+    write_clock.begin("write");
     mesh_write(out, r.mesh, options.write);
     write_clock.end("write");
   }

@@ -56,6 +56,10 @@ struct PipelineOptions {
   MeshWriteOptions write;  ///< how pipeline_run_files writes the output
   /// Where stage lines go as stages end ("select: 0.012 s"), or nullptr.
   std::ostream* verbose = nullptr;
+  /// Where the running stage is named as it starts ("\rhexrefine: check ..."), one line
+  /// overwritten by the next and cleared at the end; the CLI passes stderr when it is a
+  /// terminal. nullptr: nothing.
+  std::ostream* progress = nullptr;
 };
 
 struct PipelineResult {

@@ -16,6 +16,8 @@
 /// non-conformal by design: it is written and the checker's counts go to the report. A selection
 /// that matches nothing: a warning, the mesh is written unchanged, exit 0.
 
+#include <unistd.h>
+
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -78,6 +80,9 @@ int refine_run(const CliArgs& a) {
   if (const auto m = a.value("--max-hexes"))
     o.max_hexes = cli_parse_int_in(*m, 1, std::numeric_limits<int32_t>::max(), "--max-hexes");
   if (a.flag("--verbose")) o.verbose = &std::cerr;
+  // A progress line on long stages only where someone watches it.
+  else if (::isatty(STDERR_FILENO))
+    o.progress = &std::cerr;
   cli_output_check("hexrefine refine", out, CliOutputKind::mesh);
   {
     MeshWriteOptions write = cli_mesh_write_options(a, "hexrefine refine", out);

@@ -2,8 +2,8 @@
 /// `hexrefine convert IN OUT [--binary]`: reads IN and writes OUT, formats chosen by extension
 /// (mesh/io.hpp). Attributes travel where the output format can hold them. For .vtk and .vtu
 /// outputs the per-hex scaled Jacobian is added as the cell field "scaled_jacobian", so a viewer
-/// shows the quality without another tool. --binary selects BINARY VTK legacy output and is
-/// refused for every other output format (it would be silently ignored otherwise).
+/// shows the quality without another tool. --binary selects BINARY VTK legacy or binary Gmsh 4.1
+/// output and is refused for every other output format (it would be silently ignored otherwise).
 
 #include <iostream>
 
@@ -43,7 +43,7 @@ const CliCommand cli_convert_command = {
     "IN OUT",
     "Converts between mesh formats (by extension: .mesh .vtk .vtu .msh .e/.exo .inp).",
     {
-        {"--binary", "", "VTK legacy output in BINARY instead of ASCII (.vtk only)"},
+        {"--binary", "", "binary instead of text output (.vtk: BINARY; .msh: Gmsh 4.1 binary)"},
         {"--ascii", "", "VTU output as text instead of appended binary data (.vtu only)"},
         {"--compress", "", "VTU output zlib-compressed (.vtu only)"},
     },

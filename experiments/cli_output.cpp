@@ -39,8 +39,8 @@ MeshWriteOptions cli_mesh_write_options(const CliArgs& a, const std::string& com
   options.binary = a.flag("--binary");
   options.ascii = a.flag("--ascii");
   options.compress = a.flag("--compress");
-  if (options.binary && format != MeshFormat::vtk_legacy)
-    throw InputError(command + ": --binary applies to .vtk output only (" + path + ")");
+  if (options.binary && format != MeshFormat::vtk_legacy && format != MeshFormat::gmsh)
+    throw InputError(command + ": --binary applies to .vtk and .msh output only (" + path + ")");
   if ((options.ascii || options.compress) && format != MeshFormat::vtu)
     throw InputError(command + ": --ascii and --compress apply to .vtu output only (" + path + ")");
   if (options.ascii && options.compress)

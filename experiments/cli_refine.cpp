@@ -145,7 +145,7 @@ const CliCommand cli_refine_command = {
         {"--ebe-only", "", "ablation: element-by-element templates only"},
         {"--allow-inverted", "", "refine an input with inverted hexes (no refusal, no verdict)"},
         {"--max-hexes", "N", "refuse when n*27^passes could exceed N (default 2^31-1)"},
-        {"--binary", "", "VTK legacy output in BINARY instead of ASCII (.vtk only)"},
+        {"--binary", "", "binary instead of text output (.vtk: BINARY; .msh: Gmsh 4.1 binary)"},
         {"--ascii", "", "VTU output as text instead of appended binary data (.vtu only)"},
         {"--compress", "", "VTU output zlib-compressed (.vtu only)"},
         {"--threads", "N",

@@ -232,7 +232,7 @@ void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOpt
       return io_detail::vtu_write(path, mesh, options.cell_scalars, options.ascii,
                                   options.compress);
     case MeshFormat::gmsh:
-      return io_detail::gmsh_write(path, mesh, options.cell_scalars);
+      return io_detail::gmsh_write(path, mesh, options.binary, options.cell_scalars);
     case MeshFormat::exodus:
       return io_detail::exodus_write(path, mesh, options.cell_scalars);
     case MeshFormat::abaqus:

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Reading and writing hex meshes: MEDIT (.mesh), VTK legacy (.vtk, ASCII or BINARY), VTK XML
-/// unstructured grid (.vtu), Gmsh (.msh: 4.1 read and write, 2.2 read, ASCII only), Exodus II
+/// unstructured grid (.vtu), Gmsh (.msh: 4.1 read and write, 2.2 read; text or binary), Exodus II
 /// (.e, .exo) and Abaqus input (.inp). The format is chosen by the file extension.
 ///
 /// Vertex order: all six formats store a linear hexahedron in the order of hex_convention.hpp
@@ -55,7 +55,7 @@ enum class MeshFormat { medit, vtk_legacy, vtu, gmsh, exodus, abaqus };
 MeshFormat mesh_format_of(const std::string& path);
 
 struct MeshWriteOptions {
-  bool binary = false;  ///< VTK legacy: BINARY instead of ASCII
+  bool binary = false;  ///< VTK legacy: BINARY instead of ASCII; Gmsh: binary (file type 1)
   /// VTU: text (format="ascii") instead of the default appended raw binary data.
   bool ascii = false;
   /// VTU: zlib-compress the appended data (vtkZLibDataCompressor); ignored with `ascii`.

@@ -1,15 +1,23 @@
 /// \file
-/// Gmsh ASCII meshes (.msh): format 4.1 read and write, 2.2 (also 2.0/2.1) read. Gmsh element
+/// Gmsh meshes (.msh): format 4.1 read and written, 2.2 (also 2.0/2.1) read; each in text
+/// (file type 0) and binary (file type 1; written with MeshWriteOptions::binary). Gmsh element
 /// type 5 (8-node hexahedron) has VTK's node order (nodes 0-3 at reference z = -1
-/// counter-clockwise, 4-7 above them), so nodes are copied as they are. Binary .msh files are
-/// refused. Nodes and hexes are ordered by tag when their tags are a permutation of 1..n (gmsh
-/// itself may list nodes out of tag order), otherwise by file order. The writer gives hex h the
-/// tag h + 1 and groups hexes into one volume entity per block_id, so the order survives.
+/// counter-clockwise, 4-7 above them), so nodes are copied as they are. Nodes and hexes are
+/// ordered by tag when their tags are a permutation of 1..n (gmsh itself may list nodes out of tag
+/// order), otherwise by file order. The writer is io_gmsh_write.cpp.
+///
+/// Binary files keep section names, the format line and $ElementData's tag headers as text; the
+/// numbers between are the writing machine's values, read here as little-endian (the int 1
+/// after the format line tells; a big-endian file is refused). MSH 4.1 stores dimensions, entity
+/// tags, element types and physical tags as int (4 bytes); counts and node and element tags as
+/// size_t (the format line's data size: 4 or 8 bytes); coordinates as double. MSH 2.2 stores every
+/// integer as int, keeps the node and element counts as text, and groups its elements under
+/// (type, count, tag count) headers. $ElementData values are (int element tag, doubles) in both.
+/// Errors inside binary data name the byte offset ("path: byte N: ..."), elsewhere the line.
 
 #include <algorithm>
 #include <map>
 
-#include "mesh/atomic_file.hpp"
 #include "mesh/io.hpp"
 #include "mesh/io_text.hpp"
 
@@ -42,23 +50,121 @@ std::string gmsh_string(TextCursor& in) {
   return s.substr(1, s.size() - 2);
 }
 
+/// The numbers of a section body: tokens of a text file, or values of a binary one (see the
+/// file comment). "int" values are 4 bytes in binary; "size" values are size_t in MSH 4.1 and
+/// int in MSH 2.2 (`size_bytes`). Positions are lines in text and byte offsets in binary.
+class GmshNumbers {
+ public:
+  GmshNumbers(TextCursor& in, bool binary, int size_bytes)
+      : in_(in), binary_(binary), size_bytes_(size_bytes) {}
+
+  bool binary() const { return binary_; }
+  TextCursor& text() { return in_; }
+  int64_t here() const { return binary_ ? static_cast<int64_t>(in_.position()) : in_.line(); }
+  std::string message_at(int64_t where, const std::string& message) const {
+    if (!binary_) return error_at(in_.path(), where, message);
+    return in_.path() + ": byte " + std::to_string(where) + ": " + message;
+  }
+  [[noreturn]] void fail(const std::string& message) const { fail_at(here(), message); }
+  /// Fails naming position `at` (from here(), taken before the value was read).
+  [[noreturn]] void fail_at(int64_t at, const std::string& message) const {
+    throw InputError(message_at(at, message));
+  }
+  /// In a binary file the values start after the line that announced them.
+  void begin_values() {
+    if (binary_) in_.skip_line();
+  }
+
+  int64_t int_value(std::string_view what) {
+    if (!binary_) return in_.integer(what);
+    int32_t v;
+    std::memcpy(&v, bytes(4, what), 4);
+    return v;
+  }
+  int64_t size_value(std::string_view what) {
+    if (!binary_) return in_.integer(what);
+    if (size_bytes_ == 4) return int_value(what);
+    const int64_t at = here();
+    uint64_t v;
+    std::memcpy(&v, bytes(8, what), 8);
+    if (v > static_cast<uint64_t>(INT64_MAX))
+      fail_at(at, std::string(what) + " " + std::to_string(v) + " out of range");
+    return static_cast<int64_t>(v);
+  }
+  int64_t int_in(std::string_view what, int64_t lo, int64_t hi) {
+    const int64_t at = here();
+    const int64_t v = int_value(what);
+    if (v < lo || v > hi)
+      fail_at(at, "expected " + std::string(what) + " in " + std::to_string(lo) + ".." +
+                      std::to_string(hi) + ", got " + std::to_string(v));
+    return v;
+  }
+  double real(std::string_view what) {
+    if (!binary_) return in_.real(what);
+    const int64_t at = here();
+    double v;
+    std::memcpy(&v, bytes(8, what), 8);
+    if (!std::isfinite(v)) fail_at(at, "expected " + std::string(what) + " (a finite number)");
+    return v;
+  }
+  /// A size value in [0, limit] whose items need at least `text_bytes` (`binary_bytes`) each of
+  /// what remains of the file; checked before the caller allocates anything.
+  int64_t count(std::string_view what, int64_t text_bytes, int64_t binary_bytes,
+                int64_t limit = INT32_MAX) {
+    const int64_t at = here();
+    const int64_t n = size_value(what);
+    const int64_t each = binary_ ? binary_bytes : text_bytes;
+    if (n < 0) fail_at(at, "expected " + std::string(what) + " >= 0, got " + std::to_string(n));
+    if (n > limit)
+      fail_at(at, std::string(what) + " " + std::to_string(n) + " exceeds the limit " +
+                      std::to_string(limit));
+    if (each > 0 && n > static_cast<int64_t>(in_.remaining()) / each)
+      fail_at(at, std::string(what) + " " + std::to_string(n) +
+                      " is more than the rest of the file (" + std::to_string(in_.remaining()) +
+                      " bytes) can hold");
+    return n;
+  }
+  /// Skips `n` size values (text tokens or binary).
+  void skip_sizes(int64_t n, std::string_view what) {
+    if (!binary_) {
+      for (int64_t k = 0; k < n; ++k) in_.integer(what);
+      return;
+    }
+    if (n > static_cast<int64_t>(in_.remaining()) / size_bytes_)
+      fail("file ends inside " + std::string(what));
+    bytes(static_cast<size_t>(n) * size_bytes_, what);
+  }
+
+ private:
+  const char* bytes(size_t n, std::string_view what) {
+    if (n > in_.remaining())
+      fail("file ends inside " + std::string(what) + " (" + std::to_string(n) +
+           " bytes expected, " + std::to_string(in_.remaining()) + " left)");
+    return in_.raw(n, what, false);
+  }
+
+  TextCursor& in_;
+  bool binary_;
+  int size_bytes_;
+};
+
 struct GmshRead {
   HexMesh mesh;
   std::vector<int64_t> node_tags;
   std::vector<int64_t> hex_tags;
   std::vector<std::array<int64_t, 8>> hex_nodes;
-  std::vector<int64_t> hex_lines;
+  std::vector<int64_t> hex_where;  ///< line or byte offset, for messages
   std::vector<int32_t> hex_block;
   struct Data {
     std::string name;
     std::vector<std::pair<int64_t, double>> values;  // element tag, value
-    int64_t line;
   };
   std::vector<Data> element_data;
 };
 
-/// Reads one element row of type `type` (tag then nodes); keeps it if it is a hex.
-void gmsh_element_row(TextCursor& in, GmshRead& g, int64_t type, int64_t tag, int32_t block) {
+/// Reads the nodes of one element of type `type` (its tag already read); keeps it if it is a hex.
+void gmsh_element_nodes_read(GmshNumbers& in, GmshRead& g, int64_t type, int64_t tag, int32_t block,
+                             int64_t where) {
   bool volume = false;
   const int n = gmsh_element_nodes(type, volume);
   if (n == 0) in.fail("unknown Gmsh element type " + std::to_string(type));
@@ -66,199 +172,282 @@ void gmsh_element_row(TextCursor& in, GmshRead& g, int64_t type, int64_t tag, in
     in.fail("element " + std::to_string(tag) + " has Gmsh type " + std::to_string(type) +
             ", a volume element that is not a linear hexahedron (only type 5 is supported)");
   if (type != 5) {
-    for (int k = 0; k < n; ++k) in.integer("node tag");
+    in.skip_sizes(n, "node tag");
     return;
   }
   std::array<int64_t, 8> nodes;
-  const int64_t line = in.line();
-  for (int k = 0; k < 8; ++k) nodes[k] = in.integer("node tag");
+  for (int k = 0; k < 8; ++k) nodes[k] = in.size_value("node tag");
   g.hex_tags.push_back(tag);
   g.hex_nodes.push_back(nodes);
-  g.hex_lines.push_back(line);
+  g.hex_where.push_back(where);
   g.hex_block.push_back(block);
 }
 
-void gmsh_skip_section(TextCursor& in, std::string_view name) {
+/// Skips a section this reader does not use. Binary sections are skipped by searching their end
+/// marker, since their bytes are not tokens.
+void gmsh_skip_section(GmshNumbers& in, std::string_view name) {
   const std::string end = "$End" + std::string(name.substr(1));
-  const std::string expected = "'" + end + "'";
-  while (in.token(expected) != end) {
+  if (in.binary()) {
+    if (!in.text().skip_to(end)) in.fail("section " + std::string(name) + " without " + end);
+    in.text().expect(end);
+    return;
   }
+  const std::string expected = "'" + end + "'";
+  while (in.text().token(expected) != end) {
+  }
+}
+
+/// $MeshFormat: the version (4.1 or 2.x), the encoding and, for binary, the size_t width and
+/// the byte order.
+struct GmshFormat {
+  bool v4;
+  bool binary;
+  int size_bytes;
+};
+
+GmshFormat gmsh_format_read(TextCursor& in) {
+  in.expect("$MeshFormat");
+  const double version = in.real("the format version");
+  const int64_t file_type = in.integer_in("the file type (0 text, 1 binary)", 0, 1);
+  const int64_t data_size = in.integer("the data size");
+  GmshFormat f{version >= 4.05 && version < 5, file_type == 1, 4};
+  if (!f.v4 && !(version >= 2 && version < 3))
+    in.fail("Gmsh format " + std::to_string(version) + " is not supported (expected 4.1 or 2.2)");
+  if (f.binary) {
+    if (data_size != 4 && data_size != 8)
+      in.fail("binary Gmsh data size " + std::to_string(data_size) + ": expected 4 or 8");
+    f.size_bytes = f.v4 ? static_cast<int>(data_size) : 4;
+    in.skip_line();
+    int32_t one;
+    std::memcpy(&one, in.raw(4, "the binary byte-order mark", false), 4);
+    if (one != 1)
+      in.fail(one == 0x01000000 ? "big-endian binary Gmsh files are not supported"
+                                : "binary Gmsh file without its byte-order mark (int 1)");
+  }
+  in.expect("$EndMeshFormat");
+  return f;
+}
+
+void gmsh_entities_read(GmshNumbers& in, std::map<int64_t, int32_t>& volume_physical) {
+  in.begin_values();
+  int64_t counts[4];
+  for (int64_t& c : counts) c = in.count("entity count", 4, 4 + 3 * 8);
+  for (int dim = 0; dim < 4; ++dim)
+    for (int64_t e = 0; e < counts[dim]; ++e) {
+      const int64_t tag = in.int_value("entity tag");
+      for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) in.real("entity bounding box");
+      const int64_t nphys = in.count("physical tag count", 2, 4);
+      for (int64_t k = 0; k < nphys; ++k) {
+        const int64_t phys = in.int_value("physical tag");
+        if (dim == 3 && k == 0) {
+          if (phys < INT32_MIN || phys > INT32_MAX) in.fail("physical tag out of range");
+          volume_physical[tag] = static_cast<int32_t>(phys);
+        }
+      }
+      if (dim > 0) {
+        const int64_t nb = in.count("bounding entity count", 2, 4);
+        for (int64_t k = 0; k < nb; ++k) in.int_value("bounding entity tag");
+      }
+    }
+  in.text().expect("$EndEntities");
+}
+
+void gmsh_nodes_read(GmshNumbers& in, const GmshFormat& f, GmshRead& g) {
+  if (f.v4) {
+    in.begin_values();
+    const int64_t blocks = in.count("node block count", 8, 12 + f.size_bytes);
+    const int64_t total = in.count("node count", 8, f.size_bytes + 24);
+    in.size_value("min node tag");
+    in.size_value("max node tag");
+    g.node_tags.reserve(static_cast<size_t>(total));
+    g.mesh.points.reserve(static_cast<size_t>(total));
+    for (int64_t b = 0; b < blocks; ++b) {
+      const int64_t dim = in.int_in("entity dimension", 0, 3);
+      in.int_value("entity tag");
+      const int64_t parametric = in.int_in("parametric flag", 0, 1);
+      const int64_t n = in.count("nodes in block", 8, f.size_bytes + 24);
+      if (static_cast<int64_t>(g.node_tags.size()) + n > total)
+        in.fail("node blocks hold more than the " + std::to_string(total) + " nodes announced");
+      for (int64_t i = 0; i < n; ++i) g.node_tags.push_back(in.size_value("node tag"));
+      for (int64_t i = 0; i < n; ++i) {
+        Eigen::Vector3d p;
+        for (int k = 0; k < 3; ++k) p[k] = in.real("node coordinate");
+        if (parametric)
+          for (int64_t k = 0; k < dim; ++k) in.real("parametric coordinate");
+        g.mesh.points.push_back(p);
+      }
+    }
+    if (static_cast<int64_t>(g.node_tags.size()) != total)
+      in.fail("node blocks hold " + std::to_string(g.node_tags.size()) + " nodes, " +
+              std::to_string(total) + " announced");
+  } else {
+    const int64_t n = in.text().count("node count", in.binary() ? 28 : 8);
+    in.begin_values();
+    g.node_tags.reserve(static_cast<size_t>(n));
+    g.mesh.points.resize(static_cast<size_t>(n));
+    for (int64_t i = 0; i < n; ++i) {
+      g.node_tags.push_back(in.size_value("node tag"));
+      for (int k = 0; k < 3; ++k) g.mesh.points[i][k] = in.real("node coordinate");
+    }
+  }
+  in.text().expect("$EndNodes");
+}
+
+void gmsh_elements_read(GmshNumbers& in, const GmshFormat& f, GmshRead& g,
+                        const std::map<int64_t, int32_t>& volume_physical) {
+  if (f.v4) {
+    in.begin_values();
+    const int64_t blocks = in.count("element block count", 8, 12 + f.size_bytes);
+    const int64_t total = in.count("element count", 4, 2 * f.size_bytes);
+    in.size_value("min element tag");
+    in.size_value("max element tag");
+    int64_t seen = 0;
+    for (int64_t b = 0; b < blocks; ++b) {
+      const int64_t dim = in.int_in("entity dimension", 0, 3);
+      const int64_t entity = in.int_value("entity tag");
+      const int64_t type = in.int_value("element type");
+      const int64_t n = in.count("elements in block", 4, 2 * f.size_bytes);
+      seen += n;
+      if (seen > total)
+        in.fail("element blocks hold more than the " + std::to_string(total) +
+                " elements announced");
+      int32_t block = 0;
+      if (dim == 3) {
+        const auto it = volume_physical.find(entity);
+        if (it != volume_physical.end()) block = it->second;
+      }
+      for (int64_t i = 0; i < n; ++i) {
+        const int64_t where = in.here();
+        const int64_t tag = in.size_value("element tag");
+        gmsh_element_nodes_read(in, g, type, tag, block, where);
+      }
+    }
+    if (seen != total)
+      in.fail("element blocks hold " + std::to_string(seen) + " elements, " +
+              std::to_string(total) + " announced");
+  } else if (!in.binary()) {
+    TextCursor& text = in.text();
+    const int64_t n = text.count("element count", 8);
+    for (int64_t i = 0; i < n; ++i) {
+      const int64_t where = in.here();
+      const int64_t tag = text.integer("element tag");
+      const int64_t type = text.integer("element type");
+      const int64_t ntags = text.integer_in("tag count", 0, 64);
+      int32_t block = 0;
+      for (int64_t k = 0; k < ntags; ++k) {
+        const int64_t t = text.integer("element tag value");
+        if (k == 0) {
+          if (t < INT32_MIN || t > INT32_MAX) text.fail("physical tag out of range");
+          block = static_cast<int32_t>(t);
+        }
+      }
+      gmsh_element_nodes_read(in, g, type, tag, block, where);
+    }
+  } else {
+    // Binary 2.2: groups of elements of one type, each headed by (type, count, tag count).
+    const int64_t n = in.text().count("element count", 12);
+    in.begin_values();
+    for (int64_t seen = 0; seen < n;) {
+      const int64_t type = in.int_value("element type");
+      const int64_t count = in.int_in("elements in group", 1, n - seen);
+      const int64_t ntags = in.int_in("tag count", 0, 64);
+      for (int64_t i = 0; i < count; ++i) {
+        const int64_t where = in.here();
+        const int64_t tag = in.int_value("element tag");
+        int32_t block = 0;
+        for (int64_t k = 0; k < ntags; ++k) {
+          const int64_t t = in.int_value("element tag value");
+          if (k == 0) block = static_cast<int32_t>(t);
+        }
+        gmsh_element_nodes_read(in, g, type, tag, block, where);
+      }
+      seen += count;
+    }
+  }
+  in.text().expect("$EndElements");
+}
+
+/// $ElementData: the tag headers are text in both encodings; single-component fields with a
+/// name are kept.
+void gmsh_element_data_read(GmshNumbers& in, GmshRead& g) {
+  TextCursor& text = in.text();
+  GmshRead::Data d;
+  const int64_t nstrings = text.integer_in("string tag count", 0, 64);
+  for (int64_t k = 0; k < nstrings; ++k) {
+    const std::string s = gmsh_string(text);
+    if (k == 0) d.name = s;
+  }
+  const int64_t nreals = text.integer_in("real tag count", 0, 64);
+  for (int64_t k = 0; k < nreals; ++k) text.real("real tag");
+  const int64_t nints = text.integer_in("integer tag count", 3, 64);
+  int64_t components = 1, count = 0;
+  for (int64_t k = 0; k < nints; ++k) {
+    const int64_t v = text.integer("integer tag");
+    if (k == 1) components = v;
+    if (k == 2) count = v;
+  }
+  if (components < 1 || components > 9)
+    text.fail("bad component count " + std::to_string(components));
+  text.check_count(count, "element data count",
+                   in.binary() ? 4 + 8 * components : 2 * (1 + components));
+  in.begin_values();
+  const bool keep = components == 1 && !d.name.empty();
+  if (keep) d.values.reserve(static_cast<size_t>(count));
+  for (int64_t i = 0; i < count; ++i) {
+    const int64_t tag = in.binary() ? in.int_value("element tag") : text.integer("element tag");
+    for (int64_t c = 0; c < components; ++c) {
+      double v = 0.5;  // NaN/inf: not an integer attribute
+      if (in.binary()) {
+        const char* p = text.raw(8, "element data value", false);
+        std::memcpy(&v, p, 8);
+        if (!std::isfinite(v)) v = 0.5;
+      } else if (!TextCursor::parse_real(text.token("element data value"), v)) {
+        v = 0.5;
+      }
+      if (keep) d.values.emplace_back(tag, v);
+    }
+  }
+  text.expect("$EndElementData");
+  if (keep) g.element_data.push_back(std::move(d));
 }
 
 }  // namespace
 
 HexMesh gmsh_read(const std::string& path, const std::string& text) {
-  TextCursor in(path, text);
+  TextCursor cursor(path, text);
+  const GmshFormat f = gmsh_format_read(cursor);
+  GmshNumbers in(cursor, f.binary, f.size_bytes);
   GmshRead g;
-  in.expect("$MeshFormat");
-  const double version = in.real("the format version");
-  const int64_t file_type = in.integer("the file type");
-  in.integer("the data size");
-  if (file_type != 0) in.fail("binary Gmsh files are not supported (save as ASCII)");
-  const bool v4 = version >= 4.05 && version < 5;
-  if (!v4 && !(version >= 2 && version < 3))
-    in.fail("Gmsh format " + std::to_string(version) + " is not supported (expected 4.1 or 2.2)");
-  in.expect("$EndMeshFormat");
   std::map<int64_t, int32_t> volume_physical;  // volume entity tag -> first physical tag
   bool have_nodes = false, have_elements = false;
-  while (!in.at_end()) {
-    const std::string_view section = in.token("a section");
-    if (section == "$Entities" && v4) {
-      int64_t counts[4];
-      for (int64_t& c : counts) c = in.count("entity count", 4);
-      for (int dim = 0; dim < 4; ++dim)
-        for (int64_t e = 0; e < counts[dim]; ++e) {
-          const int64_t tag = in.integer("entity tag");
-          for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) in.real("entity bounding box");
-          const int64_t nphys = in.count("physical tag count", 2);
-          for (int64_t k = 0; k < nphys; ++k) {
-            const int64_t phys = in.integer("physical tag");
-            if (dim == 3 && k == 0) {
-              if (phys < INT32_MIN || phys > INT32_MAX) in.fail("physical tag out of range");
-              volume_physical[tag] = static_cast<int32_t>(phys);
-            }
-          }
-          if (dim > 0) {
-            const int64_t nb = in.count("bounding entity count", 2);
-            for (int64_t k = 0; k < nb; ++k) in.integer("bounding entity tag");
-          }
-        }
-      in.expect("$EndEntities");
+  while (!cursor.at_end()) {
+    const std::string_view section = cursor.token("a section");
+    if (section == "$Entities" && f.v4) {
+      gmsh_entities_read(in, volume_physical);
     } else if (section == "$Nodes") {
-      if (have_nodes) in.fail("second $Nodes section");
+      if (have_nodes) cursor.fail("second $Nodes section");
       have_nodes = true;
-      if (v4) {
-        const int64_t blocks = in.count("node block count", 8);
-        const int64_t total = in.count("node count", 8);
-        in.integer("min node tag");
-        in.integer("max node tag");
-        g.node_tags.reserve(static_cast<size_t>(total));
-        g.mesh.points.reserve(static_cast<size_t>(total));
-        for (int64_t b = 0; b < blocks; ++b) {
-          const int64_t dim = in.integer_in("entity dimension", 0, 3);
-          in.integer("entity tag");
-          const int64_t parametric = in.integer_in("parametric flag", 0, 1);
-          const int64_t n = in.count("nodes in block", 8);
-          if (static_cast<int64_t>(g.node_tags.size()) + n > total)
-            in.fail("node blocks hold more than the " + std::to_string(total) + " nodes announced");
-          for (int64_t i = 0; i < n; ++i) g.node_tags.push_back(in.integer("node tag"));
-          for (int64_t i = 0; i < n; ++i) {
-            Eigen::Vector3d p;
-            for (int k = 0; k < 3; ++k) p[k] = in.real("node coordinate");
-            if (parametric)
-              for (int64_t k = 0; k < dim; ++k) in.real("parametric coordinate");
-            g.mesh.points.push_back(p);
-          }
-        }
-        if (static_cast<int64_t>(g.node_tags.size()) != total)
-          in.fail("node blocks hold " + std::to_string(g.node_tags.size()) + " nodes, " +
-                  std::to_string(total) + " announced");
-      } else {
-        const int64_t n = in.count("node count", 8);
-        g.node_tags.reserve(static_cast<size_t>(n));
-        g.mesh.points.resize(static_cast<size_t>(n));
-        for (int64_t i = 0; i < n; ++i) {
-          g.node_tags.push_back(in.integer("node tag"));
-          for (int k = 0; k < 3; ++k) g.mesh.points[i][k] = in.real("node coordinate");
-        }
-      }
-      in.expect("$EndNodes");
+      gmsh_nodes_read(in, f, g);
     } else if (section == "$Elements") {
-      if (have_elements) in.fail("second $Elements section");
+      if (have_elements) cursor.fail("second $Elements section");
       have_elements = true;
-      if (v4) {
-        const int64_t blocks = in.count("element block count", 8);
-        const int64_t total = in.count("element count", 4);
-        in.integer("min element tag");
-        in.integer("max element tag");
-        int64_t seen = 0;
-        for (int64_t b = 0; b < blocks; ++b) {
-          const int64_t dim = in.integer_in("entity dimension", 0, 3);
-          const int64_t entity = in.integer("entity tag");
-          const int64_t type = in.integer("element type");
-          const int64_t n = in.count("elements in block", 4);
-          seen += n;
-          if (seen > total)
-            in.fail("element blocks hold more than the " + std::to_string(total) +
-                    " elements announced");
-          int32_t block = 0;
-          if (dim == 3) {
-            const auto it = volume_physical.find(entity);
-            if (it != volume_physical.end()) block = it->second;
-          }
-          for (int64_t i = 0; i < n; ++i) {
-            const int64_t tag = in.integer("element tag");
-            gmsh_element_row(in, g, type, tag, block);
-          }
-        }
-        if (seen != total)
-          in.fail("element blocks hold " + std::to_string(seen) + " elements, " +
-                  std::to_string(total) + " announced");
-      } else {
-        const int64_t n = in.count("element count", 8);
-        for (int64_t i = 0; i < n; ++i) {
-          const int64_t tag = in.integer("element tag");
-          const int64_t type = in.integer("element type");
-          const int64_t ntags = in.integer_in("tag count", 0, 64);
-          int32_t block = 0;
-          for (int64_t k = 0; k < ntags; ++k) {
-            const int64_t t = in.integer("element tag value");
-            if (k == 0) {
-              if (t < INT32_MIN || t > INT32_MAX) in.fail("physical tag out of range");
-              block = static_cast<int32_t>(t);
-            }
-          }
-          gmsh_element_row(in, g, type, tag, block);
-        }
-      }
-      in.expect("$EndElements");
+      gmsh_elements_read(in, f, g, volume_physical);
     } else if (section == "$ElementData") {
-      GmshRead::Data d;
-      d.line = in.line();
-      const int64_t nstrings = in.integer_in("string tag count", 0, 64);
-      for (int64_t k = 0; k < nstrings; ++k) {
-        const std::string s = gmsh_string(in);
-        if (k == 0) d.name = s;
-      }
-      const int64_t nreals = in.integer_in("real tag count", 0, 64);
-      for (int64_t k = 0; k < nreals; ++k) in.real("real tag");
-      const int64_t nints = in.integer_in("integer tag count", 3, 64);
-      int64_t components = 1, count = 0;
-      for (int64_t k = 0; k < nints; ++k) {
-        const int64_t v = in.integer("integer tag");
-        if (k == 1) components = v;
-        if (k == 2) count = v;
-      }
-      if (components < 1 || components > 9)
-        in.fail("bad component count " + std::to_string(components));
-      in.check_count(count, "element data count", 2 * (1 + components));
-      const bool keep = components == 1 && !d.name.empty();
-      if (keep) d.values.reserve(static_cast<size_t>(count));
-      for (int64_t i = 0; i < count; ++i) {
-        const int64_t tag = in.integer("element tag");
-        for (int64_t c = 0; c < components; ++c) {
-          const std::string_view t = in.token("element data value");
-          double v = 0;
-          if (!TextCursor::parse_real(t, v)) v = 0.5;  // NaN/inf: not an integer attribute
-          if (keep) d.values.emplace_back(tag, v);
-        }
-      }
-      in.expect("$EndElementData");
-      if (keep) g.element_data.push_back(std::move(d));
+      gmsh_element_data_read(in, g);
     } else if (!section.empty() && section[0] == '$' && section.substr(0, 4) != "$End") {
       gmsh_skip_section(in, section);
     } else {
-      in.fail("expected a section such as $Nodes or $Elements, got '" + TextCursor::shown(section) +
-              "'");
+      cursor.fail("expected a section such as $Nodes or $Elements, got '" +
+                  TextCursor::shown(section) + "'");
     }
   }
-  if (!have_nodes || !have_elements) in.fail("expected $Nodes and $Elements sections");
+  if (!have_nodes || !have_elements) cursor.fail("expected $Nodes and $Elements sections");
 
   items_sort_by_permutation_ids(g.mesh.points, g.node_tags);
   IdIndex nodes;
   if (const int64_t bad = nodes.build(g.node_tags); bad >= 0)
-    in.fail("node tag " + std::to_string(g.node_tags[bad]) + " repeated or not positive");
-  if (g.hex_tags.size() > INT32_MAX) in.fail("too many hexes");
+    cursor.fail("node tag " + std::to_string(g.node_tags[bad]) + " repeated or not positive");
+  if (g.hex_tags.size() > INT32_MAX) cursor.fail("too many hexes");
   const size_t m = g.hex_tags.size();
   // Order: by tag when the hex tags are exactly 1..m, else file order.
   std::vector<int32_t> slot = id_permutation_slots(g.hex_tags);
@@ -270,10 +459,9 @@ HexMesh gmsh_read(const std::string& path, const std::string& text) {
     for (int k = 0; k < 8; ++k) {
       const int64_t v = nodes.find(g.hex_nodes[i][k]);
       if (v < 0)
-        throw InputError(error_at(path, g.hex_lines[i],
-                                  "hex element " + std::to_string(g.hex_tags[i]) +
-                                      " refers to undefined node " +
-                                      std::to_string(g.hex_nodes[i][k])));
+        throw InputError(in.message_at(
+            g.hex_where[i], "hex element " + std::to_string(g.hex_tags[i]) +
+                                " refers to undefined node " + std::to_string(g.hex_nodes[i][k])));
       g.mesh.hexes[slot[i]][k] = static_cast<int32_t>(v);
     }
     block[slot[i]] = g.hex_block[i];
@@ -281,9 +469,9 @@ HexMesh gmsh_read(const std::string& path, const std::string& text) {
   g.mesh.attributes.push_back({std::string(attribute_block_id), std::move(block)});
   IdIndex hexes;
   if (const int64_t bad = hexes.build(g.hex_tags); bad >= 0)
-    throw InputError(
-        error_at(path, g.hex_lines[bad],
-                 "element tag " + std::to_string(g.hex_tags[bad]) + " repeated or not positive"));
+    throw InputError(in.message_at(
+        g.hex_where[bad],
+        "element tag " + std::to_string(g.hex_tags[bad]) + " repeated or not positive"));
   for (const GmshRead::Data& d : g.element_data) {
     std::vector<int32_t> values(m, 0);
     bool integral = true;
@@ -299,89 +487,13 @@ HexMesh gmsh_read(const std::string& path, const std::string& text) {
     if (mesh_find_attribute(g.mesh, d.name) != nullptr) {
       // block_id from $ElementData overrides the physical tags (it also holds ids <= 0); other
       // repeated names are later time steps of a field already read.
-      if (d.name == attribute_block_id && d.line > 0)
-        mesh_attribute(g.mesh, d.name) = std::move(values);
+      if (d.name == attribute_block_id) mesh_attribute(g.mesh, d.name) = std::move(values);
       continue;
     }
     g.mesh.attributes.push_back({d.name, std::move(values)});
   }
   mesh_check_read(g.mesh, path);
   return std::move(g.mesh);
-}
-
-void gmsh_write(const std::string& path, const HexMesh& mesh,
-                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars) {
-  const std::vector<int32_t>* block = mesh_find_attribute(mesh, attribute_block_id);
-  const size_t m = mesh.hexes.size(), n = mesh.points.size();
-  // One volume entity per block id (entity tag = rank + 1), hexes grouped by entity.
-  std::vector<std::pair<int32_t, int32_t>> order(m);
-  for (size_t h = 0; h < m; ++h) order[h] = {block ? (*block)[h] : 0, static_cast<int32_t>(h)};
-  std::sort(order.begin(), order.end());
-  std::vector<int32_t> blocks;
-  for (const auto& [b, h] : order)
-    if (blocks.empty() || blocks.back() != b) blocks.push_back(b);
-  file_write_atomically(path, [&](std::ostream& out) {
-    TextWriter w(out);
-    w.text("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
-    w.text("$Entities\n0 0 0 ").integer(static_cast<int64_t>(blocks.size())).put('\n');
-    size_t i = 0;
-    for (size_t e = 0; e < blocks.size(); ++e) {
-      Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-      for (; i < m && order[i].first == blocks[e]; ++i)
-        for (int32_t v : mesh.hexes[order[i].second]) {
-          lo = lo.cwiseMin(mesh.points[v]);
-          hi = hi.cwiseMax(mesh.points[v]);
-        }
-      w.integer(static_cast<int64_t>(e) + 1);
-      for (int k = 0; k < 6; ++k) w.put(' ').real(k < 3 ? lo[k] : hi[k - 3]);
-      if (blocks[e] > 0)
-        w.text(" 1 ").integer(blocks[e]).text(" 0\n");
-      else
-        w.text(" 0 0\n");
-    }
-    const int64_t n64 = static_cast<int64_t>(n), m64 = static_cast<int64_t>(m);
-    w.text("$EndEntities\n$Nodes\n");
-    w.text("1 ").integer(n64).text(n ? " 1 " : " 0 ").integer(n64).put('\n');
-    w.text("3 1 0 ").integer(n64).put('\n');
-    for (int64_t v = 1; v <= n64; ++v) w.integer(v).put('\n');
-    for (const Eigen::Vector3d& p : mesh.points)
-      w.real(p.x()).put(' ').real(p.y()).put(' ').real(p.z()).put('\n');
-    w.text("$EndNodes\n$Elements\n");
-    w.integer(static_cast<int64_t>(blocks.size())).put(' ').integer(m64);
-    w.text(m ? " 1 " : " 0 ").integer(m64).put('\n');
-    i = 0;
-    for (size_t e = 0; e < blocks.size(); ++e) {
-      size_t j = i;
-      while (j < m && order[j].first == blocks[e]) ++j;
-      w.text("3 ").integer(static_cast<int64_t>(e) + 1).text(" 5 ");
-      w.integer(static_cast<int64_t>(j - i)).put('\n');
-      for (; i < j; ++i) {
-        const int32_t h = order[i].second;
-        w.integer(int64_t{h} + 1);
-        for (int32_t v : mesh.hexes[h]) w.put(' ').integer(int64_t{v} + 1);
-        w.put('\n');
-      }
-    }
-    w.text("$EndElements\n");
-    auto data_header = [&](const std::string& name) {
-      w.text("$ElementData\n1\n\"").text(name).text("\"\n1\n0\n3\n0\n1\n").integer(m64).put('\n');
-    };
-    if (m > 0) {
-      for (const HexAttribute& a : mesh.attributes) {
-        data_header(a.name);
-        for (size_t h = 0; h < m; ++h)
-          w.integer(static_cast<int64_t>(h) + 1).put(' ').integer(a.values[h]).put('\n');
-        w.text("$EndElementData\n");
-      }
-      for (const auto& [name, values] : cell_scalars) {
-        data_header(name);
-        for (size_t h = 0; h < m; ++h)
-          w.integer(static_cast<int64_t>(h) + 1).put(' ').real(values[h]).put('\n');
-        w.text("$EndElementData\n");
-      }
-    }
-    w.flush();
-  });
 }
 
 }  // namespace hexrefine::io_detail

@@ -162,15 +162,27 @@ class TextCursor {
   }
 
   /// `n` raw bytes (for binary blocks), consumed; fails naming `what` if the file is shorter.
-  const char* raw(size_t n, std::string_view what) {
+  /// `count_lines` false skips counting the newline bytes inside them (a file whose positions
+  /// are reported as byte offsets has no use for line numbers, and the scan costs a pass).
+  const char* raw(size_t n, std::string_view what, bool count_lines = true) {
     if (n > remaining())
       fail("file ends inside " + std::string(what) + " (" + std::to_string(n) +
            " bytes expected, " + std::to_string(remaining()) + " left)");
     const char* p = text_.data() + pos_;
-    for (size_t i = 0; i < n; ++i)
-      if (p[i] == '\n') ++line_;
+    if (count_lines)
+      for (size_t i = 0; i < n; ++i)
+        if (p[i] == '\n') ++line_;
     pos_ += n;
     return p;
+  }
+
+  /// Moves to the first occurrence of `needle` at or after the position; false (position
+  /// unchanged) if there is none. Lines are not counted: for skipping binary blocks.
+  bool skip_to(std::string_view needle) {
+    const size_t at = text_.find(needle, pos_);
+    if (at == std::string_view::npos) return false;
+    pos_ = at;
+    return true;
   }
 
   static bool parse_integer(std::string_view t, int64_t& v) {
@@ -308,7 +320,7 @@ void vtu_write(const std::string& path, const HexMesh& mesh,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars,
                bool ascii, bool compress);
 HexMesh gmsh_read(const std::string& path, const std::string& text);
-void gmsh_write(const std::string& path, const HexMesh& mesh,
+void gmsh_write(const std::string& path, const HexMesh& mesh, bool binary,
                 const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
 HexMesh exodus_read(const std::string& path);
 void exodus_write(const std::string& path, const HexMesh& mesh,
@@ -384,6 +396,16 @@ class TextWriter {
       count -= n;
     }
     return *this;
+  }
+  /// `count` values in the machine's own (little-endian) byte order, copied as they are.
+  template <class T>
+  TextWriter& native(const T* values, size_t count) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    return text(std::string_view(reinterpret_cast<const char*>(values), count * sizeof(T)));
+  }
+  template <class T>
+  TextWriter& native(T value) {
+    return native(&value, 1);
   }
   /// Hands the buffered bytes to the stream.
   void flush() {

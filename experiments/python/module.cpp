@@ -191,7 +191,8 @@ PYBIND11_MODULE(_hexrefine, m) {
       "cell_data"_a = py::dict(),
       "Writes a mesh atomically (format by extension); attributes travel where the format holds "
       "them, cell_data {name: m floats} as cell fields (VTK, VTU, Gmsh, Exodus). binary: VTK "
-      "legacy BINARY; VTU is appended binary data unless ascii, zlib-compressed with compress.");
+      "legacy BINARY, Gmsh 4.1 binary; VTU is appended binary data unless ascii, zlib-compressed "
+      "with compress.");
   m.def(
       "generate",
       [](const std::string& name, const py::kwargs& params) {

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Measures the issue-14 end-to-end targets: the `hexrefine refine` command on a 75^3 brick (all
-# hexes, Selective Approach, trilinear placement) to Exodus II and to VTU, one and two threads,
-# and `hexrefine check` of its 11.4 M-hex output; wall time, stage times (--report) and peak
+# hexes, Selective Approach, trilinear placement) to Exodus II, to VTU and to binary Gmsh 4.1,
+# one and two threads, and `hexrefine check` of its 11.4 M-hex output in each format; wall time, stage times (--report) and peak
 # memory (/usr/bin/time -v) of each command, output sizes, and the floor of this machine's file
 # system: the time `dd` takes to write as many bytes into the page cache. Writes
 # results/performance/command.json; report.py turns it into a section of results/performance.md.
 # Needs a Release build (cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && make -C build hexrefine)
-# and about 3 GB of memory and 3 GB of disk in $TMPDIR; about 2 minutes on an idle machine.
+# and about 3 GB of memory and 4 GB of disk in $TMPDIR; about 3 minutes on an idle machine.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 bin=$repo/build/experiments/hexrefine
@@ -31,17 +31,22 @@ run() {
   runs+=("{\"name\": \"$name\", \"wall_s\": $wall, \"peak_rss_MB\": $((peak / 1024)), \"report\": $report}")
 }
 for threads in 1 2; do
-  for ext in e vtu; do
+  for ext in e vtu msh; do
+    switch=()
+    [ "$ext" = msh ] && switch=(--binary)
     run "refine_${ext}_threads_$threads" "$bin" refine "$tmp/b75.e" "$tmp/out.$ext" \
-      --method selective --select all --placement trilinear --threads "$threads" \
+      --method selective --select all --placement trilinear --threads "$threads" "${switch[@]}" \
       --report "$tmp/refine_${ext}_threads_$threads.json"
   done
 done
 size_e=$(stat -c %s "$tmp/out.e")
 size_vtu=$(stat -c %s "$tmp/out.vtu")
+size_msh=$(stat -c %s "$tmp/out.msh")
 for threads in 1 2; do
-  run "check_e_threads_$threads" "$bin" check "$tmp/out.e" --threads "$threads" \
-    --report "$tmp/check_e_threads_$threads.json"
+  for ext in e vtu msh; do
+    run "check_${ext}_threads_$threads" "$bin" check "$tmp/out.$ext" --threads "$threads" \
+      --report "$tmp/check_${ext}_threads_$threads.json"
+  done
 done
 # The file-system floor: writing size_e bytes of zeros into the page cache (no computation).
 start=$(date +%s%N)
@@ -52,7 +57,7 @@ floor=$(awk "BEGIN { print ($end - $start) / 1e9 }")
   echo "{"
   echo "  \"date\": \"$(date -u +%Y-%m-%dT%H:%M:%SZ)\", \"commit\": \"$(git -C "$repo" rev-parse HEAD)\","
   echo "  \"cpus\": $(nproc), \"load_average\": \"$(cut -d' ' -f1-3 /proc/loadavg)\","
-  echo "  \"output_bytes\": {\"e\": $size_e, \"vtu\": $size_vtu},"
+  echo "  \"output_bytes\": {\"e\": $size_e, \"vtu\": $size_vtu, \"msh\": $size_msh},"
   echo "  \"page_cache_write_floor_s\": $floor,"
   echo "  \"runs\": ["
   for i in "${!runs[@]}"; do

@@ -19,10 +19,18 @@ TEST(CliConvert, ConvertsSharedMeshToEveryFormat) {
     EXPECT_NE(r.output.find("10600 hexes"), std::string::npos) << r.output;
     EXPECT_EQ(mesh_read(out).hex_count(), 10600) << ext;
   }
-  const std::string bin = (dir / "rocker_bin.vtk").string();
-  const CliRun r = cli_run("convert " + shared_mesh("rockerarm.mesh") + " " + bin + " --binary");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(mesh_read(bin).hex_count(), 10600);
+  for (const char* ext : {".vtk", ".msh"}) {
+    const std::string bin = (dir / (std::string("rocker_bin") + ext)).string();
+    const CliRun r = cli_run("convert " + shared_mesh("rockerarm.mesh") + " " + bin + " --binary");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const HexMesh binary = mesh_read(bin);
+    EXPECT_EQ(binary.hex_count(), 10600) << ext;
+    EXPECT_EQ(binary.points, mesh_read(shared_mesh("rockerarm.mesh")).points) << ext;
+  }
+  std::ifstream msh((dir / "rocker_bin.msh").string(), std::ios::binary);
+  std::string head(20, ' ');
+  msh.read(head.data(), 20);
+  EXPECT_EQ(head, "$MeshFormat\n4.1 1 8\n");
 }
 
 /// The values of the double cell array `name` in an ASCII VTK legacy file written by hexrefine.
@@ -88,9 +96,11 @@ TEST(CliConvert, BadInputExitsTwoNamingTheFile) {
   EXPECT_NE(r.output.find("x.stl"), std::string::npos) << r.output;
   r = cli_run("convert " + shared_mesh("sphere_conforming.mesh"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  r = cli_run("convert " + shared_mesh("sphere_conforming.mesh") + " " + (dir / "x.msh").string() +
+  r = cli_run("convert " + shared_mesh("sphere_conforming.mesh") + " " + (dir / "x.vtu").string() +
               " --binary");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--binary applies to .vtk and .msh output only"), std::string::npos)
+      << r.output;
   r = cli_run("convert " + (dir / "missing.mesh").string() + " " + out);
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("missing.mesh"), std::string::npos) << r.output;

@@ -4,13 +4,15 @@
 usage: check_external_readers.py HEXREFINE SHARED_DIR TEMP_DIR
 
 Converts the shared meshes and a generated jittered brick to every format hexrefine writes
-(.mesh, .vtk ASCII and BINARY, .vtu appended binary, zlib and ASCII, .msh, .e, .inp) with
+(.mesh, .vtk ASCII and BINARY, .vtu appended binary, zlib and ASCII, .msh text and binary, .e,
+.inp) with
 `hexrefine convert`, then checks:
   - meshio reads every file with the right hex count;
   - VTK (python3-vtk9) reads the .vtk, .vtu and .e files with the right hex count;
   - vtkMeshQuality's hex scaled Jacobian equals our "scaled_jacobian" cell data to 1e-9
     (rockerarm.mesh and the brick, .vtk and .vtu);
-  - the gmsh command-line program loads every .msh without an error and counts the same hexes.
+  - the gmsh command-line program loads every .msh without an error and counts the same hexes;
+  - hexrefine reads the binary .msh files meshio and gmsh write (4.1 and 2.2).
 Prints one line per check and a final "N passed, M failed"; exits 1 on any failure.
 """
 
@@ -20,10 +22,11 @@ import os
 import subprocess
 import sys
 
-FORMATS = [".mesh", ".vtk", "_binary.vtk", ".vtu", "_compressed.vtu", "_ascii.vtu", ".msh", ".e",
-           ".inp"]
+FORMATS = [".mesh", ".vtk", "_binary.vtk", ".vtu", "_compressed.vtu", "_ascii.vtu", ".msh",
+           "_binary.msh", ".e", ".inp"]
 # hexrefine convert's switch for each variant of a format.
-SWITCHES = {"_binary.vtk": ["--binary"], "_compressed.vtu": ["--compress"], "_ascii.vtu": ["--ascii"]}
+SWITCHES = {"_binary.vtk": ["--binary"], "_binary.msh": ["--binary"], "_compressed.vtu": ["--compress"],
+            "_ascii.vtu": ["--ascii"]}
 # Shared meshes: name -> hex count from shared/meshes/README.md (sphere_sculpt.e: counted by meshio).
 SHARED = {
     "rockerarm.mesh": 10600,
@@ -166,7 +169,7 @@ def main():
                                % (target, gap, worst))
                 except Exception as e:  # noqa: BLE001
                     report(False, "VTK reads %s: %s" % (target, e))
-            if fmt == ".msh":
+            if fmt.endswith(".msh"):
                 code, out = run(["gmsh", "-check", target])
                 # gmsh warns about inverted hexes (a property of the mesh, e.g. the negative test
                 # mesh sphere_projected_inverted); any other warning or error is a failure.
@@ -180,7 +183,7 @@ def main():
                           ("; " + "; ".join(errors[:5])) if errors else ""))
 
     # The other way round: what meshio writes (VTU with inline binary data, zlib-compressed,
-    # its default, and uncompressed; ASCII) our reader takes.
+    # its default, and uncompressed; ASCII; binary Gmsh) and what gmsh writes our reader takes.
     import meshio
     source = meshio.read(os.path.join(meshes_dir, "rockerarm.mesh"))
     for binary, compression in ((True, "zlib"), (True, None), (False, None)):
@@ -192,6 +195,25 @@ def main():
         code, out = run([exe, "check", target])
         report(code == 0 and "10600 hexes" in out,
                "hexrefine check reads meshio's %s: %s" % (os.path.basename(target), out.splitlines()[0] if out else ""))
+
+    # Binary Gmsh as meshio (4.1 and 2.2) and the gmsh program (4.1 and 2.2) write it.
+    # (hexes only: meshio's 4.1 writer wants entity information for more than one cell type)
+    hexes_only = meshio.Mesh(source.points, [(c.type, c.data) for c in source.cells if c.type == "hexahedron"])
+    for fmt in ("gmsh", "gmsh22"):
+        target = os.path.join(tmp, "meshio_%s_binary.msh" % fmt)
+        meshio.write(target, hexes_only, file_format=fmt, binary=True)
+        code, out = run([exe, "check", target])
+        report(code == 0 and "10600 hexes" in out,
+               "hexrefine check reads meshio's %s: %s" % (os.path.basename(target), out.splitlines()[0] if out else ""))
+    for version in ("msh41", "msh22"):
+        target = os.path.join(tmp, "gmsh_%s_binary.msh" % version)
+        code, out = run(["gmsh", "-0", "-bin", "-format", version, os.path.join(tmp, "rockerarm.msh"), "-o", target])
+        if code != 0:
+            report(False, "gmsh -0 -bin -format %s: exit %d: %s" % (version, code, out.strip()[-300:]))
+            continue
+        code, out = run([exe, "check", target])
+        report(code == 0 and "10600 hexes" in out,
+               "hexrefine check reads gmsh's %s: %s" % (os.path.basename(target), out.splitlines()[0] if out else ""))
 
     print("%d passed, %d failed" % (passed, failed))
     return 0 if failed == 0 else 1

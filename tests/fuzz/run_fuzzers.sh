@@ -16,7 +16,7 @@
 # to reproduce with `$FUZZ_BUILD_DIR/tests/fuzz/fuzz_<format> <input>`; 2 if the build failed.
 set -u
 if [ $# -lt 1 ] || ! [[ "$1" =~ ^[0-9]+$ ]]; then
-  echo "usage: $0 SECONDS [TARGET ...]  (targets: medit vtk_ascii vtk_binary vtu gmsh22 gmsh41 abaqus exodus)" >&2
+  echo "usage: $0 SECONDS [TARGET ...]  (targets: medit vtk_ascii vtk_binary vtu gmsh22 gmsh41 gmsh_binary abaqus exodus)" >&2
   exit 2
 fi
 seconds=$1
@@ -29,7 +29,7 @@ cc=${CLANG_CC:-clang-14}
 jobs=${JOBS:-2}
 rss=${FUZZ_RSS_MB:-1024}
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(medit vtk_ascii vtk_binary vtu gmsh22 gmsh41 abaqus exodus)
+[ ${#targets[@]} -eq 0 ] && targets=(medit vtk_ascii vtk_binary vtu gmsh22 gmsh41 gmsh_binary abaqus exodus)
 
 if ! command -v "$cxx" > /dev/null; then
   echo "$0: $cxx not found: the fuzzers need clang with libFuzzer (CLANG_CXX=...)" >&2
@@ -49,7 +49,7 @@ make -C "$build" -j"$jobs" $(printf 'fuzz_%s ' "${targets[@]}") > "$build/fuzz-b
 dict_of() {
   case $1 in
     vtk_ascii | vtk_binary) echo vtk ;;
-    gmsh22 | gmsh41) echo gmsh ;;
+    gmsh22 | gmsh41 | gmsh_binary) echo gmsh ;;
     *) echo "$1" ;;
   esac
 }

@@ -86,11 +86,13 @@ def test_arrays_round_trip_through_hexmesh():
     assert hexrefine.quality(mesh, "volume").tolist() == [pytest.approx(1.0)]
 
 
-@pytest.mark.parametrize("extension", [".vtu", ".vtk", ".mesh", ".e", ".msh"])
-def test_refined_mesh_round_trips_through_files(brick10, tmp_path, extension):
+@pytest.mark.parametrize("extension,binary", [(".vtu", False), (".vtk", False), (".vtk", True),
+                                              (".mesh", False), (".e", False), (".msh", False),
+                                              (".msh", True)])
+def test_refined_mesh_round_trips_through_files(brick10, tmp_path, extension, binary):
     refined, _ = hexrefine.refine(brick10, "sphere:0,0,0,0.35")
     path = str(tmp_path / ("refined" + extension))
-    hexrefine.write(refined, path)
+    hexrefine.write(refined, path, binary=binary)
     back = hexrefine.read(path)
     assert back.hex_count == refined.hex_count and back.point_count == refined.point_count
     np.testing.assert_array_equal(back.hexes, refined.hexes)

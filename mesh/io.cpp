@@ -1,5 +1,8 @@
 #include "mesh/io.hpp"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -37,6 +40,25 @@ std::string file_read_all(const std::string& path) {
     text.append(piece, static_cast<size_t>(in.gcount()));
   if (in.bad()) throw InputError(path + ": read failed");
   return text;
+}
+
+FileBytes::FileBytes(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  struct stat st {};
+  if (fd >= 0 && ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+    void* p = ::mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
+    if (p != MAP_FAILED) {
+      ::madvise(p, static_cast<size_t>(st.st_size), MADV_SEQUENTIAL);
+      map_ = static_cast<const char*>(p);
+      size_ = static_cast<size_t>(st.st_size);
+    }
+  }
+  if (fd >= 0) ::close(fd);
+  if (map_ == nullptr) copy_ = file_read_all(path);  // also names the path if it cannot be read
+}
+
+FileBytes::~FileBytes() {
+  if (map_ != nullptr) ::munmap(const_cast<char*>(map_), size_);
 }
 
 int64_t IdIndex::build(const std::vector<int64_t>& ids) {
@@ -149,17 +171,17 @@ HexMesh mesh_read(const std::string& path) {
     throw InputError(path + ": is a folder, expected a mesh file");
   switch (format) {
     case MeshFormat::medit:
-      return io_detail::medit_read(path, io_detail::file_read_all(path));
+      return io_detail::medit_read(path, io_detail::FileBytes(path).view());
     case MeshFormat::vtk_legacy:
-      return io_detail::vtk_read(path, io_detail::file_read_all(path));
+      return io_detail::vtk_read(path, io_detail::FileBytes(path).view());
     case MeshFormat::vtu:
-      return io_detail::vtu_read(path, io_detail::file_read_all(path));
+      return io_detail::vtu_read(path, io_detail::FileBytes(path).view());
     case MeshFormat::gmsh:
-      return io_detail::gmsh_read(path, io_detail::file_read_all(path));
+      return io_detail::gmsh_read(path, io_detail::FileBytes(path).view());
     case MeshFormat::exodus:
       return io_detail::exodus_read(path);
     case MeshFormat::abaqus:
-      return io_detail::abaqus_read(path, io_detail::file_read_all(path));
+      return io_detail::abaqus_read(path, io_detail::FileBytes(path).view());
   }
   throw InputError(path + ": unknown mesh format");
 }
@@ -191,7 +213,7 @@ HexMesh mesh_read_from_memory(const std::string& name, std::string_view bytes) {
       throw InputError(message);
     }
   }
-  const std::string text(bytes);
+  const std::string_view text = bytes;
   switch (format) {
     case MeshFormat::medit:
       return io_detail::medit_read(name, text);

@@ -85,7 +85,7 @@ struct AbaqusSet {
 
 }  // namespace
 
-HexMesh abaqus_read(const std::string& path, const std::string& text) {
+HexMesh abaqus_read(const std::string& path, std::string_view text) {
   TextCursor in(path, text);
   HexMesh mesh;
   std::vector<int64_t> node_ids, node_lines;

@@ -148,19 +148,35 @@ class GmshNumbers {
   int size_bytes_;
 };
 
+/// What the sections leave for the end of gmsh_read. Hexes are stored as node indices at once
+/// ($Nodes precedes $Elements, so the node index exists), and $ElementData fields as int32
+/// values, keyed by position while their element tags run 1, 2, 3, ...: the intermediate stays
+/// small beside the file for a 10 M-hex mesh.
 struct GmshRead {
   HexMesh mesh;
   std::vector<int64_t> node_tags;
+  IdIndex nodes;  ///< node tag -> index, built when $Elements starts
   std::vector<int64_t> hex_tags;
-  std::vector<std::array<int64_t, 8>> hex_nodes;
   std::vector<int64_t> hex_where;  ///< line or byte offset, for messages
   std::vector<int32_t> hex_block;
   struct Data {
     std::string name;
-    std::vector<std::pair<int64_t, double>> values;  // element tag, value
+    std::vector<int64_t> tags;    ///< the element tags, empty while they are 1, 2, ..., count
+    std::vector<int32_t> values;  ///< in file order; cleared once a value is not an int32
+    bool integral = true;
   };
   std::vector<Data> element_data;
 };
+
+/// Room for `count` hexes (an upper bound the file's size was checked against), so that a large
+/// file is not read into vectors that grow by copying.
+void gmsh_hexes_reserve(GmshRead& g, int64_t count) {
+  const size_t n = static_cast<size_t>(count);
+  g.mesh.hexes.reserve(n);
+  g.hex_tags.reserve(n);
+  g.hex_where.reserve(n);
+  g.hex_block.reserve(n);
+}
 
 /// Reads the nodes of one element of type `type` (its tag already read); keeps it if it is a hex.
 void gmsh_element_nodes_read(GmshNumbers& in, GmshRead& g, int64_t type, int64_t tag, int32_t block,
@@ -175,10 +191,18 @@ void gmsh_element_nodes_read(GmshNumbers& in, GmshRead& g, int64_t type, int64_t
     in.skip_sizes(n, "node tag");
     return;
   }
-  std::array<int64_t, 8> nodes;
-  for (int k = 0; k < 8; ++k) nodes[k] = in.size_value("node tag");
+  HexCell cell;
+  for (int k = 0; k < 8; ++k) {
+    const int64_t node = in.size_value("node tag");
+    const int64_t v = g.nodes.find(node);
+    if (v < 0)
+      throw InputError(in.message_at(where, "hex element " + std::to_string(tag) +
+                                                " refers to undefined node " +
+                                                std::to_string(node)));
+    cell[k] = static_cast<int32_t>(v);
+  }
+  g.mesh.hexes.push_back(cell);
   g.hex_tags.push_back(tag);
-  g.hex_nodes.push_back(nodes);
   g.hex_where.push_back(where);
   g.hex_block.push_back(block);
 }
@@ -301,6 +325,7 @@ void gmsh_elements_read(GmshNumbers& in, const GmshFormat& f, GmshRead& g,
     const int64_t total = in.count("element count", 4, 2 * f.size_bytes);
     in.size_value("min element tag");
     in.size_value("max element tag");
+    gmsh_hexes_reserve(g, total);
     int64_t seen = 0;
     for (int64_t b = 0; b < blocks; ++b) {
       const int64_t dim = in.int_in("entity dimension", 0, 3);
@@ -317,9 +342,10 @@ void gmsh_elements_read(GmshNumbers& in, const GmshFormat& f, GmshRead& g,
         if (it != volume_physical.end()) block = it->second;
       }
       for (int64_t i = 0; i < n; ++i) {
-        const int64_t where = in.here();
+        // Binary: the row's first byte; text: the line of its tag (read first).
+        const int64_t before = in.here();
         const int64_t tag = in.size_value("element tag");
-        gmsh_element_nodes_read(in, g, type, tag, block, where);
+        gmsh_element_nodes_read(in, g, type, tag, block, in.binary() ? before : in.here());
       }
     }
     if (seen != total)
@@ -328,9 +354,10 @@ void gmsh_elements_read(GmshNumbers& in, const GmshFormat& f, GmshRead& g,
   } else if (!in.binary()) {
     TextCursor& text = in.text();
     const int64_t n = text.count("element count", 8);
+    gmsh_hexes_reserve(g, n);
     for (int64_t i = 0; i < n; ++i) {
-      const int64_t where = in.here();
       const int64_t tag = text.integer("element tag");
+      const int64_t where = in.here();
       const int64_t type = text.integer("element type");
       const int64_t ntags = text.integer_in("tag count", 0, 64);
       int32_t block = 0;
@@ -346,6 +373,7 @@ void gmsh_elements_read(GmshNumbers& in, const GmshFormat& f, GmshRead& g,
   } else {
     // Binary 2.2: groups of elements of one type, each headed by (type, count, tag count).
     const int64_t n = in.text().count("element count", 12);
+    gmsh_hexes_reserve(g, n);
     in.begin_values();
     for (int64_t seen = 0; seen < n;) {
       const int64_t type = in.int_value("element type");
@@ -404,16 +432,28 @@ void gmsh_element_data_read(GmshNumbers& in, GmshRead& g) {
       } else if (!TextCursor::parse_real(text.token("element data value"), v)) {
         v = 0.5;
       }
-      if (keep) d.values.emplace_back(tag, v);
+      if (!keep || !d.integral) continue;
+      if (v != std::floor(v) || v < INT32_MIN || v > INT32_MAX) {
+        d.integral = false;
+        d.values = {};
+        d.tags = {};
+        continue;
+      }
+      if (d.tags.empty() && tag != i + 1) {  // tags not 1, 2, ...: keep them from here on
+        d.tags.reserve(static_cast<size_t>(count));
+        for (int64_t k = 0; k < i; ++k) d.tags.push_back(k + 1);
+      }
+      if (!d.tags.empty() || tag != i + 1) d.tags.push_back(tag);
+      d.values.push_back(static_cast<int32_t>(v));
     }
   }
   text.expect("$EndElementData");
-  if (keep) g.element_data.push_back(std::move(d));
+  if (keep && d.integral) g.element_data.push_back(std::move(d));
 }
 
 }  // namespace
 
-HexMesh gmsh_read(const std::string& path, const std::string& text) {
+HexMesh gmsh_read(const std::string& path, std::string_view text) {
   TextCursor cursor(path, text);
   const GmshFormat f = gmsh_format_read(cursor);
   GmshNumbers in(cursor, f.binary, f.size_bytes);
@@ -430,7 +470,12 @@ HexMesh gmsh_read(const std::string& path, const std::string& text) {
       gmsh_nodes_read(in, f, g);
     } else if (section == "$Elements") {
       if (have_elements) cursor.fail("second $Elements section");
+      if (!have_nodes) cursor.fail("$Elements before $Nodes (Gmsh files list the nodes first)");
       have_elements = true;
+      items_sort_by_permutation_ids(g.mesh.points, g.node_tags);
+      if (const int64_t bad = g.nodes.build(g.node_tags); bad >= 0)
+        cursor.fail("node tag " + std::to_string(g.node_tags[bad]) + " repeated or not positive");
+      g.node_tags = {};
       gmsh_elements_read(in, f, g, volume_physical);
     } else if (section == "$ElementData") {
       gmsh_element_data_read(in, g);
@@ -443,47 +488,35 @@ HexMesh gmsh_read(const std::string& path, const std::string& text) {
   }
   if (!have_nodes || !have_elements) cursor.fail("expected $Nodes and $Elements sections");
 
-  items_sort_by_permutation_ids(g.mesh.points, g.node_tags);
-  IdIndex nodes;
-  if (const int64_t bad = nodes.build(g.node_tags); bad >= 0)
-    cursor.fail("node tag " + std::to_string(g.node_tags[bad]) + " repeated or not positive");
   if (g.hex_tags.size() > INT32_MAX) cursor.fail("too many hexes");
   const size_t m = g.hex_tags.size();
-  // Order: by tag when the hex tags are exactly 1..m, else file order.
-  std::vector<int32_t> slot = id_permutation_slots(g.hex_tags);
-  if (slot.empty())
-    for (size_t i = 0; i < m; ++i) slot.push_back(static_cast<int32_t>(i));
-  g.mesh.hexes.resize(m);
-  std::vector<int32_t> block(m);
-  for (size_t i = 0; i < m; ++i) {
-    for (int k = 0; k < 8; ++k) {
-      const int64_t v = nodes.find(g.hex_nodes[i][k]);
-      if (v < 0)
-        throw InputError(in.message_at(
-            g.hex_where[i], "hex element " + std::to_string(g.hex_tags[i]) +
-                                " refers to undefined node " + std::to_string(g.hex_nodes[i][k])));
-      g.mesh.hexes[slot[i]][k] = static_cast<int32_t>(v);
-    }
-    block[slot[i]] = g.hex_block[i];
-  }
-  g.mesh.attributes.push_back({std::string(attribute_block_id), std::move(block)});
   IdIndex hexes;
   if (const int64_t bad = hexes.build(g.hex_tags); bad >= 0)
     throw InputError(in.message_at(
         g.hex_where[bad],
         "element tag " + std::to_string(g.hex_tags[bad]) + " repeated or not positive"));
-  for (const GmshRead::Data& d : g.element_data) {
-    std::vector<int32_t> values(m, 0);
-    bool integral = true;
-    for (const auto& [tag, v] : d.values) {
-      const int64_t i = hexes.find(tag);
-      if (i < 0) continue;  // data of a skipped element
-      if (v != std::floor(v) || v < INT32_MIN || v > INT32_MAX)
-        integral = false;
-      else
-        values[slot[i]] = static_cast<int32_t>(v);
+  // Order: by tag when the hex tags are exactly 1..m, else file order.
+  const std::vector<int32_t> slot = id_permutation_slots(g.hex_tags);
+  if (!slot.empty()) {
+    std::vector<HexCell> cells(m);
+    std::vector<int32_t> blocks(m);
+    for (size_t i = 0; i < m; ++i) {
+      cells[slot[i]] = g.mesh.hexes[i];
+      blocks[slot[i]] = g.hex_block[i];
     }
-    if (!integral) continue;
+    g.mesh.hexes = std::move(cells);
+    g.hex_block = std::move(blocks);
+  }
+  auto slot_of = [&](size_t i) { return slot.empty() ? static_cast<int32_t>(i) : slot[i]; };
+  g.mesh.attributes.push_back({std::string(attribute_block_id), std::move(g.hex_block)});
+  for (GmshRead::Data& d : g.element_data) {
+    std::vector<int32_t> values(m, 0);
+    for (size_t k = 0; k < d.values.size(); ++k) {
+      const int64_t i = hexes.find(d.tags.empty() ? static_cast<int64_t>(k) + 1 : d.tags[k]);
+      if (i >= 0) values[slot_of(static_cast<size_t>(i))] = d.values[k];  // else: a skipped element
+    }
+    d.values = {};
+    d.tags = {};
     if (mesh_find_attribute(g.mesh, d.name) != nullptr) {
       // block_id from $ElementData overrides the physical tags (it also holds ids <= 0); other
       // repeated names are later time steps of a field already read.

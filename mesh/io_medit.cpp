@@ -46,7 +46,7 @@ constexpr MeditSection medit_sections[] = {
 
 }  // namespace
 
-HexMesh medit_read(const std::string& path, const std::string& text) {
+HexMesh medit_read(const std::string& path, std::string_view text) {
   TextCursor in(path, text, '#');
   HexMesh mesh;
   std::vector<int32_t>& block = mesh_attribute(mesh, attribute_block_id);

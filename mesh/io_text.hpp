@@ -27,6 +27,27 @@ namespace hexrefine::io_detail {
 /// The whole file as bytes; InputError naming the path if it cannot be opened or read.
 std::string file_read_all(const std::string& path);
 
+/// The bytes of a file for a reader: a regular file is mapped read-only (mmap), so a large file
+/// costs neither a copy nor a zero-filled buffer of its size (on the 2-core machine the two were
+/// a third of the time to read a 1.7 GB binary Gmsh file); anything else (a pipe, a file that
+/// cannot be mapped) is read with file_read_all. InputError naming the path if the file cannot
+/// be opened or read. The mapping is private; like any reader of a file, it expects the file not
+/// to be truncated by another process while it reads (hexrefine's own writers replace files by
+/// rename, which leaves a mapped file intact).
+class FileBytes {
+ public:
+  explicit FileBytes(const std::string& path);
+  ~FileBytes();
+  FileBytes(const FileBytes&) = delete;
+  FileBytes& operator=(const FileBytes&) = delete;
+  std::string_view view() const { return map_ ? std::string_view(map_, size_) : copy_; }
+
+ private:
+  const char* map_ = nullptr;
+  size_t size_ = 0;
+  std::string copy_;
+};
+
 /// Tokens separated by white space (and by `extra_separators`, e.g. "," for Abaqus); `comment`
 /// (if not 0) starts a comment running to the end of the line. Tracks the 1-based line number
 /// of the last token for error messages. The text is borrowed: it must outlive the cursor.
@@ -310,22 +331,22 @@ T read_big_endian(const char* p) {
 
 // Per-format entry points (io_<format>.cpp); mesh_read / mesh_write dispatch to them. The text
 // readers parse `text` (the file's bytes) and use `path` only in messages.
-HexMesh medit_read(const std::string& path, const std::string& text);
+HexMesh medit_read(const std::string& path, std::string_view text);
 void medit_write(const std::string& path, const HexMesh& mesh);
-HexMesh vtk_read(const std::string& path, const std::string& text);
+HexMesh vtk_read(const std::string& path, std::string_view text);
 void vtk_write(const std::string& path, const HexMesh& mesh, const bool binary,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
-HexMesh vtu_read(const std::string& path, const std::string& text);
+HexMesh vtu_read(const std::string& path, std::string_view text);
 void vtu_write(const std::string& path, const HexMesh& mesh,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars,
                bool ascii, bool compress);
-HexMesh gmsh_read(const std::string& path, const std::string& text);
+HexMesh gmsh_read(const std::string& path, std::string_view text);
 void gmsh_write(const std::string& path, const HexMesh& mesh, bool binary,
                 const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
 HexMesh exodus_read(const std::string& path);
 void exodus_write(const std::string& path, const HexMesh& mesh,
                   const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
-HexMesh abaqus_read(const std::string& path, const std::string& text);
+HexMesh abaqus_read(const std::string& path, std::string_view text);
 void abaqus_write(const std::string& path, const HexMesh& mesh);
 
 /// The writers' output buffer: numbers are formatted straight into one 1 MiB buffer with

@@ -177,7 +177,7 @@ void vtk_read_data_block(TextCursor& in, bool binary, VtkReadState& st, bool cel
 
 }  // namespace
 
-HexMesh vtk_read(const std::string& path, const std::string& text) {
+HexMesh vtk_read(const std::string& path, std::string_view text) {
   TextCursor in(path, text);
   const std::string_view first = in.rest_of_line();
   if (first.substr(0, 14) != "# vtk DataFile")

@@ -237,7 +237,7 @@ int64_t line_of(std::string_view text, size_t pos) {
 
 }  // namespace
 
-HexMesh vtu_read(const std::string& path, const std::string& text) {
+HexMesh vtu_read(const std::string& path, std::string_view text) {
   const std::string_view all(text);
   auto fail_at = [&](size_t pos, const std::string& message) -> void {
     throw InputError(error_at(path, line_of(all, pos), message));

@@ -58,6 +58,10 @@ TEST(IoGmsh, RefusesTetsUndefinedNodesAndOtherVersions) {
       {head + "$Elements\n1 1 1 1\n3 1 99 1\n1 1 2\n$EndElements\n",
        "unknown Gmsh element type 99"},
       {"$MeshFormat\n3.0 0 8\n$EndMeshFormat\n", "not supported (expected 4.1 or 2.2)"},
+      {"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Elements\n0 0 0 0\n$EndElements\n",
+       ":4: $Elements before $Nodes"},
+      {head + "$Elements\n1 2 1 2\n3 1 5 2\n1 1 2 3 4 1 2 3 4\n1 1 2 3 4 1 2 3 4\n$EndElements\n",
+       ":20: element tag 1 repeated or not positive"},
       {"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 100000000000 1 4\n",
        "node count 100000000000"},
   };

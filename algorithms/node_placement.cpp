@@ -28,8 +28,10 @@
 ///     around the active ones (node neighbours in the refined mesh), gathered without building
 ///     the output's topology. Serial, worst node first, ties by id: the same result for any
 ///     --threads.
-///  4. A child of a valid parent still inverted after the sweeps is a refusal (OperationError
-///     naming the input hexes and their scaled Jacobians), unless allow_inverted.
+///  4. A child of a valid parent still inverted after the sweeps: its parent is returned, and
+///     the driver refines that parent as a target in a new plan of the pass (refiner.cpp); when
+///     that does not help, a refusal (OperationError naming the input hexes and their scaled
+///     Jacobians), unless allow_inverted.
 
 #include "algorithms/node_placement.hpp"
 
@@ -136,9 +138,9 @@ BoundaryReference boundary_reference_build(const HexMesh& input, const HexTopolo
   return r;
 }
 
-void place_new_nodes(const PlacementPass& pass, HexMesh& refined, const PlacementOptions& options,
-                     PlacementStats& stats) {
-  if (options.method == PlacementMethod::trilinear) return;
+std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined,
+                                     const PlacementOptions& options, PlacementStats& stats) {
+  if (options.method == PlacementMethod::trilinear) return {};
   const auto start = std::chrono::steady_clock::now();
   const HexMesh& current = pass.current;
   const HexTopology& topology = pass.topology;
@@ -174,7 +176,7 @@ void place_new_nodes(const PlacementPass& pass, HexMesh& refined, const Placemen
     }
   }
   stats.active_hexes += static_cast<int64_t>(active.size());
-  if (active.empty()) return;
+  if (active.empty()) return {};
 
   // The hexes around the free nodes: children of the parents node-adjacent to the active ones
   // (a new node lies on its parent's closure, so every hex holding it is a child of a parent
@@ -300,9 +302,15 @@ void place_new_nodes(const PlacementPass& pass, HexMesh& refined, const Placemen
     still_inverted += !(hex_scaled_jacobian(hex_points(refined, active[a])) > 0);
   stats.untangled += std::max<int64_t>(0, stats.inverted_before - still_inverted);
   stats.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (failed.empty() || pass.allow_inverted) return;
+  if (failed.empty() || pass.allow_inverted) return {};
   std::sort(failed.begin(), failed.end());
   failed.erase(std::unique(failed.begin(), failed.end()), failed.end());
+  if (!pass.refuse) {
+    std::vector<int32_t> parents;
+    for (int32_t u : failed) parents.push_back(index_of(uses[u].hex));
+    std::sort(parents.begin(), parents.end());
+    return parents;
+  }
   std::string list;
   for (size_t i = 0; i < failed.size() && i < 10; ++i) {
     const int32_t h = index_of(uses[failed[i]].hex);

@@ -106,12 +106,17 @@ struct PlacementPass {
   std::span<const int32_t> original_of;
   const BoundaryReference& reference;
   bool allow_inverted = false;
+  /// What a child of a valid parent left inverted leads to: true, an OperationError naming the
+  /// input hexes and their scaled Jacobians; false, the parents are returned to the caller (the
+  /// refinement driver then makes them targets and plans the pass again, refiner.cpp).
+  bool refuse = true;
 };
 
 /// Moves the new nodes of `refined` (the pass's output, its nodes from current.point_count() on
-/// new) as PlacementOptions say; accumulates into `stats`. Throws OperationError naming the input
-/// hexes (and their scaled Jacobians) whose children stay inverted, unless allow_inverted.
-void place_new_nodes(const PlacementPass& pass, HexMesh& refined, const PlacementOptions& options,
-                     PlacementStats& stats);
+/// new) as PlacementOptions say; accumulates into `stats`. Returns the parents (hex ids of
+/// `current`, ascending) whose children stay inverted when neither allow_inverted nor refuse is
+/// set; empty otherwise. Throws OperationError for them under `refuse` (see PlacementPass).
+std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined,
+                                     const PlacementOptions& options, PlacementStats& stats);
 
 }  // namespace hexrefine

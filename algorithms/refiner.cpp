@@ -166,28 +166,56 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
         }
       std::sort(pass_targets.begin(), pass_targets.end());
     }
-    const RefinementPlan plan = method.plan(*current, topology, pass_targets, options, stats);
-    stats.phase_seconds["plan"] += seconds_since(t);
+    // Plan, apply, place. A parent whose children placement cannot make valid (a distorted hex
+    // under a transition template) becomes a target and the pass is planned again: refined by
+    // a template of boxes, its children are images of boxes under its own map, and the
+    // transition moves to its neighbours. At most placement_retries new plans; the counts of a
+    // dropped plan are undone, its time is kept.
+    constexpr int placement_retries = 3;
+    const RefineStats stats_before_plan = stats;
+    RefinementPlan plan;
+    PlanApplyResult applied;
+    for (int attempt = 0;; ++attempt) {
+      plan = method.plan(*current, topology, pass_targets, options, stats);
+      stats.phase_seconds["plan"] += seconds_since(t);
 
-    t = Clock::now();
-    PlanApplyResult applied = plan_apply(*current, topology, plan, options.threads);
-    stats.phase_seconds["apply"] += seconds_since(t);
+      t = Clock::now();
+      applied = plan_apply(*current, topology, plan, options.threads);
+      stats.phase_seconds["apply"] += seconds_since(t);
 
-    t = Clock::now();
-    if (options.placement.method != PlacementMethod::trilinear) {
-      if (pass == 0) reference = boundary_reference_build(*current, topology);
-      const std::vector<int32_t>* original = mesh_find_attribute(*current, attribute_parent_hex);
-      const PlacementPass placement{
-          *current,
-          topology,
-          plan,
-          applied.first_child,
-          original ? std::span<const int32_t>(*original) : std::span<const int32_t>(),
-          reference,
-          options.allow_inverted};
-      place_new_nodes(placement, applied.mesh, options.placement, stats.placement);
+      t = Clock::now();
+      std::vector<int32_t> failed;
+      if (options.placement.method != PlacementMethod::trilinear) {
+        if (pass == 0 && attempt == 0) reference = boundary_reference_build(*current, topology);
+        const std::vector<int32_t>* original = mesh_find_attribute(*current, attribute_parent_hex);
+        const PlacementPass placement{
+            *current,
+            topology,
+            plan,
+            applied.first_child,
+            original ? std::span<const int32_t>(*original) : std::span<const int32_t>(),
+            reference,
+            options.allow_inverted,
+            attempt == placement_retries};
+        failed = place_new_nodes(placement, applied.mesh, options.placement, stats.placement);
+      }
+      stats.phase_seconds["placement"] += seconds_since(t);
+      if (failed.empty()) break;
+      const std::map<std::string, double> seconds = stats.phase_seconds;
+      const int64_t retargeted = stats.placement_retargets;
+      stats = stats_before_plan;
+      stats.phase_seconds = seconds;
+      stats.placement_retargets = retargeted;
+      const size_t before = pass_targets.size();
+      for (int32_t h : failed)
+        if (!std::binary_search(pass_targets.begin(), pass_targets.begin() + before, h))
+          pass_targets.push_back(h);
+      stats.placement_retargets += static_cast<int64_t>(pass_targets.size() - before);
+      std::sort(pass_targets.begin(), pass_targets.end());
+      // Nothing new to refine: the next plan is the same, so let it refuse.
+      if (pass_targets.size() == before) attempt = placement_retries - 1;
+      t = Clock::now();
     }
-    stats.phase_seconds["placement"] += seconds_since(t);
 
     if (pass + 1 < options.passes) {
       // The next pass's core: the children of this pass's core (with PassBuffer::transitions

@@ -105,6 +105,9 @@ struct RefineStats {
   /// Input edges the selective refiner split to avoid an adjustment it could not carry out;
   /// each cost one restart of the pass (phase "restarted_passes" holds their time).
   int64_t input_edges_forced = 0;
+  /// Hexes made targets of their pass because node placement found no valid position for the
+  /// children a transition template gave them (refiner.cpp); each such pass was planned again.
+  int64_t placement_retargets = 0;
   PlacementStats placement;
   /// Seconds per phase: the method's own (marking, element_by_element, ranking, ...) and the
   /// driver's (plan, apply, placement, total).
@@ -115,7 +118,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(
     RefineStats, method, initial_hexes, final_hexes, final_nodes, hexes_per_template, hexes_created,
     hexes_deleted, directional_hexes, directional_groups, ranks, doublets_resolved,
     doublets_by_rule, edges_split_by_propagation, sheet_passes, added_targets,
-    self_intersection_cases, input_edges_forced, placement, phase_seconds, time_seconds)
+    self_intersection_cases, input_edges_forced, placement_retargets, placement, phase_seconds,
+    time_seconds)
 
 /// Fills stats.hexes_per_template from a list of per-hex template tags.
 void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags);

@@ -124,6 +124,24 @@ TEST(NodePlacement, FormerRefusalsAreUntangledAndValid) {
   }
 }
 
+TEST(NodePlacement, ParentsPlacementCannotSaveBecomeTargetsOfTheirPass) {
+  // bunny_conforming.mesh, two selective passes under the thesis' layer rule (the real-mesh
+  // study's "two-passes" case): in pass 2 the 1-13 transition in input hex 25722 (scaled
+  // Jacobian 0.28) leaves a child at -0.006 that no move of its six new nodes repairs (its two
+  // input nodes are fixed and the neighbouring children are at 0.001 and 0.004). That hex
+  // becomes a target of pass 2, which is planned again; the result is valid.
+  const HexMesh m = mesh_read(shared_mesh("bunny_conforming.mesh"));
+  RefineOptions o;
+  o.passes = 2;
+  o.buffer = PassBuffer::layer;
+  const Targets t{select_hexes(m, {"sphere:8.8e-05,0.000294,0.0014555,0.346278"}).hexes};
+  const RefineResult r = refine(refine_method("selective"), m, t, o);
+  EXPECT_TRUE(mesh_check(r.mesh, &m).valid());
+  EXPECT_EQ(r.stats.placement_retargets, 1);
+  EXPECT_EQ(r.mesh.hex_count(), 204591);
+  EXPECT_GT(mesh_min_scaled_jacobian(r.mesh), 0.01);
+}
+
 TEST(NodePlacement, RealMeshesRandomTargetsValidOnTheBoundaryAndNeverWorseThanTrilinear) {
   // Seeded target sets (selection specs random:, blob:, sphere:) on the shared real meshes, both
   // refiners. Measured floor (results/real_meshes.md): the output minimum stays above 0.05 of

@@ -294,14 +294,19 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
                        " bytes) can hold");
 
   VtkReadState st;
-  std::vector<int64_t> connectivity, offsets, types;
+  // Connectivity and types as Int32 (a point id or a cell type outside it is refused where it is
+  // read), offsets as Int64: a 10 M-hex file's arrays in half the memory of Int64 throughout.
+  std::vector<int32_t> connectivity, types;
+  std::vector<int64_t> offsets;
   bool have_points = false;
   struct Pending {
     std::string name;
     size_t begin;
     int64_t line;
     std::string type;
-    std::string bytes;  ///< the decoded values of a binary array
+    std::string bytes;           ///< the decoded values of a binary array
+    std::string_view file_data;  ///< or, raw and uncompressed, its values in the file itself
+    bool in_file = false;
     bool binary = false;
   };
   std::vector<Pending> cell_arrays;
@@ -348,7 +353,9 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
     // The values end at the first nested element (VTK writes <InformationKey> after them).
     const size_t values_end = self_closing ? tag_end : std::min(close, all.find('<', tag_end + 1));
     const bool binary = format != "ascii";
-    std::string bytes;  // a binary array's decoded values
+    std::string bytes;      // a binary array's decoded values
+    std::string_view data;  // its values: `bytes`, or the file's own bytes (raw, uncompressed)
+    bool in_file = false;
     if (format == "binary") {
       bytes = vtu_block_decode_base64(all.substr(tag_end + 1, values_end - tag_end - 1),
                                       block_format, path, tag_end + 1);
@@ -364,10 +371,14 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
       if (appended_base64) {
         const size_t length = vtu_block_base64_length(all.substr(at), block_format, path, at);
         bytes = vtu_block_decode_base64(all.substr(at, length), block_format, path, at);
+      } else if (!block_format.zlib) {
+        data = vtu_block_raw_data(all.substr(at), block_format, path, at, nullptr);  // no copy
+        in_file = true;
       } else {
         bytes = vtu_block_decode_raw(all.substr(at), block_format, path, at, nullptr);
       }
     }
+    if (!in_file) data = bytes;
     TextCursor in(path, all.substr(tag_end + 1, values_end - tag_end - 1));
     in.set_line(line_at(tag_end + 1));
     const std::string what = "values of DataArray '" + name + "'";
@@ -391,7 +402,7 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
         ++i;
       };
       if (binary)
-        vtu_binary_values(path, bytes, legacy_type, 3 * np, "point coordinates",
+        vtu_binary_values(path, data, legacy_type, 3 * np, "point coordinates",
                           [&](double d, int64_t v) {
                             if (!std::isfinite(d))
                               throw InputError(path + ": point " + std::to_string(i / 3) +
@@ -402,25 +413,34 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
         vtk_read_values(in, false, legacy_type, 3 * np, "point coordinate", false, store);
       have_points = true;
     } else if (section == in_cells && section >= 0) {
-      std::vector<int64_t>* out = name == "connectivity" ? &connectivity
-                                  : name == "offsets"    ? &offsets
-                                  : name == "types"      ? &types
-                                                         : nullptr;
-      if (out == nullptr) fail_at(p, "unknown Cells DataArray '" + name + "'");
+      std::vector<int32_t>* out32 = name == "connectivity" ? &connectivity
+                                    : name == "types"      ? &types
+                                                           : nullptr;
+      if (out32 == nullptr && name != "offsets")
+        fail_at(p, "unknown Cells DataArray '" + name + "'");
+      auto append = [&](int64_t v) {
+        if (out32 == nullptr) return offsets.push_back(v);
+        if (v < INT32_MIN || v > INT32_MAX)
+          fail_at(p, "DataArray '" + name + "' holds " + std::to_string(v) + ", out of range");
+        out32->push_back(static_cast<int32_t>(v));
+      };
+      auto reserve = [&](size_t n) { out32 ? out32->reserve(n) : offsets.reserve(n); };
       if (binary) {
         const int value_size = vtk_type_size(legacy_type);
-        if (value_size <= 0 || bytes.size() % static_cast<size_t>(value_size) != 0)
-          fail_at(p, what + ": " + std::to_string(bytes.size()) + " bytes, not whole values");
-        out->reserve(bytes.size() / static_cast<size_t>(value_size));
-        vtu_binary_values(path, bytes, legacy_type, static_cast<int64_t>(bytes.size()) / value_size,
-                          what, [&](double, int64_t v) { out->push_back(v); });
+        if (value_size <= 0 || data.size() % static_cast<size_t>(value_size) != 0)
+          fail_at(p, what + ": " + std::to_string(data.size()) + " bytes, not whole values");
+        reserve(data.size() / static_cast<size_t>(value_size));
+        vtu_binary_values(path, data, legacy_type, static_cast<int64_t>(data.size()) / value_size,
+                          what, [&](double, int64_t v) { append(v); });
       }
+      size_t read = 0;
       while (!binary && !in.at_end()) {
-        if (out->size() >= static_cast<size_t>(size)) in.fail("too many values");
-        out->push_back(in.integer(what));
+        if (read++ >= static_cast<size_t>(size)) in.fail("too many values");
+        append(in.integer(what));
       }
     } else if (section == in_cell_data && section >= 0) {
-      cell_arrays.push_back({name, tag_end + 1, in.line(), legacy_type, std::move(bytes), binary});
+      cell_arrays.push_back({name, tag_end + 1, in.line(), legacy_type, std::move(bytes),
+                             in_file ? data : std::string_view(), in_file, binary});
       if (comps != "" && comps != "1") cell_arrays.back().type = "";  // multi-component: skipped
     }
     if (!binary && section >= 0 && !in.at_end() && (section == in_points || section == in_cells))
@@ -431,6 +451,7 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
   if (static_cast<int64_t>(offsets.size()) != nc || static_cast<int64_t>(types.size()) != nc)
     fail_at(piece, "Cells offsets/types need NumberOfCells = " + std::to_string(nc) + " values");
   st.hex_of_cell.assign(static_cast<size_t>(nc), -1);
+  st.mesh.hexes.reserve(static_cast<size_t>(nc));
   int64_t start = 0;
   for (int64_t c = 0; c < nc; ++c) {
     const int64_t end = offsets[c];
@@ -471,12 +492,13 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
       std::vector<int32_t> values(st.mesh.hexes.size());
       int64_t i = 0;
       const std::string what = "DataArray '" + a.name + "'";
-      vtu_binary_values(path, a.bytes, a.type, nc, what, [&](double, int64_t v) {
-        if (v < INT32_MIN || v > INT32_MAX)
-          throw InputError(path + ": " + what + ": " + std::to_string(v) + " exceeds int32");
-        const int32_t h = st.hex_of_cell[i++];
-        if (h >= 0) values[h] = static_cast<int32_t>(v);
-      });
+      vtu_binary_values(
+          path, a.in_file ? a.file_data : a.bytes, a.type, nc, what, [&](double, int64_t v) {
+            if (v < INT32_MIN || v > INT32_MAX)
+              throw InputError(path + ": " + what + ": " + std::to_string(v) + " exceeds int32");
+            const int32_t h = st.hex_of_cell[i++];
+            if (h >= 0) values[h] = static_cast<int32_t>(v);
+          });
       st.mesh.attributes.push_back({a.name, std::move(values)});
       continue;
     }

@@ -137,6 +137,11 @@ std::string without_white_space(std::string_view text) {
 std::string vtu_block_decode_raw(std::string_view bytes, const VtuBlockFormat& format,
                                  const std::string& path, size_t file_offset, size_t* consumed) {
   if (format.zlib) return inflate_blocks(bytes, format, path, file_offset, consumed);
+  return std::string(vtu_block_raw_data(bytes, format, path, file_offset, consumed));
+}
+
+std::string_view vtu_block_raw_data(std::string_view bytes, const VtuBlockFormat& format,
+                                    const std::string& path, size_t file_offset, size_t* consumed) {
   const size_t hb = static_cast<size_t>(format.header_bytes);
   if (bytes.size() < hb) fail_at_byte(path, file_offset, "block header truncated");
   const uint64_t size = header_integer(bytes, 0, format.header_bytes);
@@ -145,7 +150,7 @@ std::string vtu_block_decode_raw(std::string_view bytes, const VtuBlockFormat& f
                  "block of " + std::to_string(size) + " bytes, but only " +
                      std::to_string(bytes.size() - hb) + " follow");
   if (consumed) *consumed = hb + static_cast<size_t>(size);
-  return std::string(bytes.substr(hb, static_cast<size_t>(size)));
+  return bytes.substr(hb, static_cast<size_t>(size));
 }
 
 namespace {

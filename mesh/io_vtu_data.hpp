@@ -28,6 +28,10 @@ struct VtuBlockFormat {
 /// The data bytes of the raw block at the start of `bytes`; `consumed` receives the block's
 /// length. InputError "path: byte N: ..." (N = `file_offset` + the offset of the defect) if the
 /// block is truncated, a size is absurd or a zlib stream does not inflate to its size.
+/// The data bytes of an uncompressed raw block (precondition: !format.zlib) as a view into
+/// `bytes`, not copied; checks and `consumed` as vtu_block_decode_raw.
+std::string_view vtu_block_raw_data(std::string_view bytes, const VtuBlockFormat& format,
+                                    const std::string& path, size_t file_offset, size_t* consumed);
 std::string vtu_block_decode_raw(std::string_view bytes, const VtuBlockFormat& format,
                                  const std::string& path, size_t file_offset, size_t* consumed);
 

@@ -144,6 +144,20 @@ TEST(IoVtu, ReadsVtkStyleAsciiWithInformationKeysAndRefusesCorruptBinary) {
     // The digits are base64 characters: the header decodes to an absurd size.
     EXPECT_NE(std::string(e.what()).find("binary.vtu: byte "), std::string::npos) << e.what();
   }
+  // A point id beyond Int32 is refused where it is read (connectivity is held as Int32).
+  std::string wide = head + "ascii" + tail;
+  const std::string ids = "0 1 3 2 4 5\n7 6";
+  wide.replace(wide.find(ids), ids.size(), "0 1 3 2 4 5\n7 5000000000");
+  const auto w = dir / "wide.vtu";
+  io_write_text(w, wide);
+  try {
+    mesh_read(w.string());
+    FAIL() << "point id 5000000000 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'connectivity' holds 5000000000, out of range"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(IoFormat, ByExtension) {

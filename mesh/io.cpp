@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -53,8 +54,33 @@ FileBytes::FileBytes(const std::string& path) {
       size_ = static_cast<size_t>(st.st_size);
     }
   }
-  if (fd >= 0) ::close(fd);
-  if (map_ == nullptr) copy_ = file_read_all(path);  // also names the path if it cannot be read
+  if (fd < 0) {
+    copy_ = file_read_all(path);  // names the path: missing or not readable
+    return;
+  }
+  if (S_ISDIR(st.st_mode)) {
+    ::close(fd);
+    throw InputError(path + ": it is a folder, not a mesh file");
+  }
+  // Not mapped (a pipe, a special file, an empty file, mmap refused): read from the descriptor
+  // already open, since opening a pipe again would wait for another writer.
+  bool read_failed = false;
+  if (map_ == nullptr) {
+    char piece[1 << 16];
+    for (;;) {
+      const ssize_t n = ::read(fd, piece, sizeof piece);
+      if (n > 0) {
+        copy_.append(piece, static_cast<size_t>(n));
+      } else if (n == 0) {
+        break;
+      } else if (errno != EINTR) {
+        read_failed = true;
+        break;
+      }
+    }
+  }
+  ::close(fd);
+  if (read_failed) throw InputError(path + ": read failed");
 }
 
 FileBytes::~FileBytes() {

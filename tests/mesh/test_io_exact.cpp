@@ -1,13 +1,15 @@
 /// Exactness of every format's coordinates (bit for bit, -0.0 and subnormals included), the
 /// shortest-form text the ASCII writers print, and the writers' buffer (io_text.hpp TextWriter)
-/// across its flush boundaries.
+/// across its flush boundaries; and how the readers get a file's bytes (file_read_all, FileBytes).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <bit>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <thread>
 
 #include "cli_runner.hpp"
 #include "io_test_support.hpp"
@@ -208,6 +210,50 @@ TEST(IoReadAll, ReadsEmptyAndMultiPieceFilesWhole) {
   io_write_text(p, big);
   EXPECT_TRUE(io_detail::file_read_all(p.string()) == big);
   EXPECT_THROW(io_detail::file_read_all((dir / "missing").string()), InputError);
+}
+
+TEST(IoFileBytes, MapsRegularFilesAndReadsPipes) {
+  const auto dir = test_temp_dir("io_file_bytes");
+  std::string big(300000, '\0');
+  for (size_t i = 0; i < big.size(); ++i) big[i] = static_cast<char>(i * 11 + (i >> 7));
+  const auto p = dir / "big.bin";
+  io_write_text(p, big);
+  EXPECT_TRUE(io_detail::FileBytes(p.string()).view() == big);
+  const auto empty = dir / "empty.bin";
+  io_write_text(empty, "");
+  EXPECT_EQ(io_detail::FileBytes(empty.string()).view(), "");
+  try {
+    io_detail::FileBytes missing((dir / "missing.mesh").string());
+    FAIL() << "a missing file was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.mesh"), std::string::npos) << e.what();
+  }
+  try {
+    io_detail::FileBytes folder(dir.string());
+    FAIL() << "a folder was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("it is a folder"), std::string::npos) << e.what();
+  }
+  // A pipe cannot be mapped: it is read from the descriptor FileBytes opened (opening it again
+  // would wait for another writer), and mesh_read takes a mesh from it whole.
+  const auto fifo = dir / "pipe.mesh";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.string().c_str(), 0600), 0);
+  const HexMesh brick = io_test_brick();
+  const auto source = dir / "brick.mesh";
+  mesh_write(source.string(), brick);
+  const std::string text = io_detail::file_read_all(source.string());
+  std::thread writer([&] { std::ofstream(fifo, std::ios::binary) << text; });
+  HexMesh read;
+  try {
+    read = mesh_read(fifo.string());
+  } catch (...) {
+    std::ifstream release(fifo);  // lets a writer still waiting for a reader finish
+    writer.join();
+    throw;
+  }
+  writer.join();
+  io_expect_same_geometry(brick, read, 0);
 }
 
 }  // namespace

@@ -87,6 +87,49 @@ FileBytes::~FileBytes() {
   if (map_ != nullptr) ::munmap(const_cast<char*>(map_), size_);
 }
 
+HexBlocks hex_blocks_group(const HexMesh& mesh, int32_t default_id) {
+  HexBlocks g;
+  const size_t m = mesh.hexes.size();
+  g.starts.push_back(0);
+  if (m == 0) return g;
+  const std::vector<int32_t>* block = mesh_find_attribute(mesh, attribute_block_id);
+  g.order.resize(m);
+  if (block == nullptr) {
+    for (size_t h = 0; h < m; ++h) g.order[h] = static_cast<int32_t>(h);
+    g.ids.push_back(default_id);
+    g.starts.push_back(m);
+    return g;
+  }
+  const auto [lo, hi] = std::minmax_element(block->begin(), block->end());
+  // hi >= lo, so span is in [1, 2^32]; the dense count is taken only up to m + 1024 ids.
+  const size_t span = size_t{static_cast<uint32_t>(*hi) - static_cast<uint32_t>(*lo)} + 1;
+  if (span <= m + 1024) {
+    std::vector<size_t> count(span + 1, 0);
+    for (int32_t b : *block) ++count[static_cast<size_t>(int64_t{b} - *lo) + 1];
+    for (size_t k = 0; k + 1 < count.size(); ++k)
+      if (count[k + 1] > 0) {
+        g.ids.push_back(static_cast<int32_t>(*lo + static_cast<int64_t>(k)));
+        g.starts.push_back(g.starts.back() + count[k + 1]);
+      }
+    for (size_t k = 1; k < count.size(); ++k) count[k] += count[k - 1];
+    for (size_t h = 0; h < m; ++h)
+      g.order[count[static_cast<size_t>(int64_t{(*block)[h]} - *lo)]++] = static_cast<int32_t>(h);
+    return g;
+  }
+  std::vector<std::pair<int32_t, int32_t>> pairs(m);
+  for (size_t h = 0; h < m; ++h) pairs[h] = {(*block)[h], static_cast<int32_t>(h)};
+  std::sort(pairs.begin(), pairs.end());
+  for (size_t i = 0; i < m; ++i) {
+    g.order[i] = pairs[i].second;
+    if (i == 0 || pairs[i].first != pairs[i - 1].first) {
+      if (i > 0) g.starts.push_back(i);
+      g.ids.push_back(pairs[i].first);
+    }
+  }
+  g.starts.push_back(m);
+  return g;
+}
+
 int64_t IdIndex::build(const std::vector<int64_t>& ids) {
   int64_t max_id = 0;
   for (size_t i = 0; i < ids.size(); ++i) {

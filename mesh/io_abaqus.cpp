@@ -271,15 +271,14 @@ void abaqus_write(const std::string& path, const HexMesh& mesh) {
       w.put('\n');
     }
     if (block != nullptr) {
-      std::vector<std::pair<int32_t, int32_t>> order(block->size());
-      for (size_t h = 0; h < order.size(); ++h) order[h] = {(*block)[h], static_cast<int32_t>(h)};
-      std::sort(order.begin(), order.end());
-      for (size_t i = 0; i < order.size(); ++i) {
-        const bool first = i == 0 || order[i].first != order[i - 1].first;
-        const bool last = i + 1 == order.size() || order[i + 1].first != order[i].first;
-        if (first) w.text("*ELSET, ELSET=BLOCK_").integer(order[i].first).put('\n');
-        w.integer(int64_t{order[i].second} + 1);
-        w.text((last || (i % 16) == 15) ? "\n" : ", ");
+      const HexBlocks groups = hex_blocks_group(mesh, 0);
+      for (size_t b = 0; b < groups.ids.size(); ++b) {
+        w.text("*ELSET, ELSET=BLOCK_").integer(groups.ids[b]).put('\n');
+        for (size_t i = groups.starts[b]; i < groups.starts[b + 1]; ++i) {
+          const bool last = i + 1 == groups.starts[b + 1];
+          w.integer(int64_t{groups.order[i]} + 1);
+          w.text((last || (i % 16) == 15) ? "\n" : ", ");
+        }
       }
     }
     w.flush();

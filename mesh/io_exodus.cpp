@@ -322,14 +322,10 @@ HexMesh exodus_read(const std::string& path) {
 
 void exodus_write(const std::string& path, const HexMesh& mesh,
                   const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars) {
-  const std::vector<int32_t>* block = mesh_find_attribute(mesh, attribute_block_id);
   const size_t m = mesh.hexes.size(), n = mesh.points.size();
-  std::vector<std::pair<int32_t, int32_t>> order(m);
-  for (size_t h = 0; h < m; ++h) order[h] = {block ? (*block)[h] : 1, static_cast<int32_t>(h)};
-  std::sort(order.begin(), order.end());
-  std::vector<int64_t> blocks;
-  for (const auto& [b, h] : order)
-    if (blocks.empty() || blocks.back() != b) blocks.push_back(b);
+  const HexBlocks groups = hex_blocks_group(mesh, 1);
+  const std::vector<int32_t>& order = groups.order;
+  const std::vector<int64_t> blocks(groups.ids.begin(), groups.ids.end());
   // Exodus id of each block: the block_id itself when positive, else a fresh id above them all.
   std::vector<int64_t> exodus_ids(blocks.size());
   int64_t next_id = std::max<int64_t>(blocks.empty() ? 0 : blocks.back(), 0) + 1;
@@ -363,14 +359,11 @@ void exodus_write(const std::string& path, const HexMesh& mesh,
     char cx[] = "x", cy[] = "y", cz[] = "z";
     char* coordinate_names[] = {cx, cy, cz};
     if (ex_put_coord_names(file.id, coordinate_names) < 0) failed("coordinate names");
-    std::vector<size_t> block_first(blocks.size() + 1, 0);  // hexes of block bi: order[first..)
-    for (size_t bi = 0, i = 0; bi < blocks.size(); ++bi) {
+    const std::vector<size_t>& block_first = groups.starts;  // hexes of block bi: order[first..)
+    for (size_t bi = 0; bi < blocks.size(); ++bi) {
       const int64_t b = blocks[bi], eid = exodus_ids[bi];
-      block_first[bi] = i;
-      while (i < m && order[i].first == b) ++i;
-      block_first[bi + 1] = i;
       if (ex_put_block(file.id, EX_ELEM_BLOCK, eid, "HEX8",
-                       static_cast<int64_t>(i - block_first[bi]), 8, 0, 0, 0) < 0)
+                       static_cast<int64_t>(block_first[bi + 1] - block_first[bi]), 8, 0, 0, 0) < 0)
         failed("element block " + std::to_string(b));
       if (b <= 0) {
         const std::string name = "hexrefine_block_id=" + std::to_string(b);
@@ -416,7 +409,7 @@ void exodus_write(const std::string& path, const HexMesh& mesh,
     for (size_t begin = 0; begin < m; begin += exodus_chunk) {
       const size_t end = std::min(m, begin + exodus_chunk);
       map.clear();
-      for (size_t k = begin; k < end; ++k) map.push_back(order[k].second + 1);
+      for (size_t k = begin; k < end; ++k) map.push_back(int64_t{order[k]} + 1);
       if (ex_put_partial_id_map(file.id, EX_ELEM_MAP, static_cast<int64_t>(begin + 1),
                                 static_cast<int64_t>(end - begin), map.data()) < 0)
         failed("element id map");
@@ -448,7 +441,7 @@ void exodus_write(const std::string& path, const HexMesh& mesh,
         const size_t end = std::min(block_first[bi + 1], begin + exodus_chunk);
         conn.clear();
         for (size_t k = begin; k < end; ++k)
-          for (int32_t v : mesh.hexes[order[k].second]) conn.push_back(v + 1);
+          for (int32_t v : mesh.hexes[order[k]]) conn.push_back(v + 1);
         const size_t start[2] = {begin - block_first[bi], 0}, count[2] = {end - begin, 8};
         if (nc_put_vara_int(file.id, conn_id, start, count, conn.data()) != NC_NOERR)
           failed("connectivity of element block " + std::to_string(b));
@@ -460,7 +453,7 @@ void exodus_write(const std::string& path, const HexMesh& mesh,
         for (size_t begin = block_first[bi]; begin < block_first[bi + 1]; begin += exodus_chunk) {
           const size_t end = std::min(block_first[bi + 1], begin + exodus_chunk);
           values.clear();
-          for (size_t k = begin; k < end; ++k) values.push_back(fields[f][order[k].second]);
+          for (size_t k = begin; k < end; ++k) values.push_back(fields[f][order[k]]);
           if (ex_put_partial_var(file.id, 1, EX_ELEM_BLOCK, static_cast<int>(f + 1), exodus_ids[bi],
                                  static_cast<int64_t>(begin - block_first[bi] + 1),
                                  static_cast<int64_t>(end - begin), values.data()) < 0)

@@ -17,15 +17,10 @@ void gmsh_write(const std::string& path, const HexMesh& mesh, bool binary,
   static_assert(std::endian::native == std::endian::little,
                 "the binary Gmsh writer assumes little-endian");
   static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "points are written as one block");
-  const std::vector<int32_t>* block = mesh_find_attribute(mesh, attribute_block_id);
   const size_t m = mesh.hexes.size(), n = mesh.points.size();
   // One volume entity per block id (entity tag = rank + 1), hexes grouped by entity.
-  std::vector<std::pair<int32_t, int32_t>> order(m);
-  for (size_t h = 0; h < m; ++h) order[h] = {block ? (*block)[h] : 0, static_cast<int32_t>(h)};
-  std::sort(order.begin(), order.end());
-  std::vector<int32_t> blocks;
-  for (const auto& [b, h] : order)
-    if (blocks.empty() || blocks.back() != b) blocks.push_back(b);
+  const HexBlocks groups = hex_blocks_group(mesh, 0);
+  const std::vector<int32_t>& blocks = groups.ids;
   file_write_atomically(path, [&](std::ostream& out) {
     TextWriter w(out);
     // The numbers of a section: a token and its separator, or a binary int / size_t / double.
@@ -56,11 +51,10 @@ void gmsh_write(const std::string& path, const HexMesh& mesh, bool binary,
     w.text("$EndMeshFormat\n$Entities\n");
     for (int k = 0; k < 3; ++k) size_value(0, ' ');
     size_value(static_cast<int64_t>(blocks.size()), '\n');
-    size_t i = 0;
     for (size_t e = 0; e < blocks.size(); ++e) {
       Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-      for (; i < m && order[i].first == blocks[e]; ++i)
-        for (int32_t v : mesh.hexes[order[i].second]) {
+      for (size_t i = groups.starts[e]; i < groups.starts[e + 1]; ++i)
+        for (int32_t v : mesh.hexes[groups.order[i]]) {
           lo = lo.cwiseMin(mesh.points[v]);
           hi = hi.cwiseMax(mesh.points[v]);
         }
@@ -92,16 +86,14 @@ void gmsh_write(const std::string& path, const HexMesh& mesh, bool binary,
     size_value(m64, ' ');
     size_value(m ? 1 : 0, ' ');
     size_value(m64, '\n');
-    i = 0;
     for (size_t e = 0; e < blocks.size(); ++e) {
-      size_t j = i;
-      while (j < m && order[j].first == blocks[e]) ++j;
+      const size_t i0 = groups.starts[e], j = groups.starts[e + 1];
       int_value(3, ' ');
       int_value(static_cast<int64_t>(e) + 1, ' ');
       int_value(5, ' ');
-      size_value(static_cast<int64_t>(j - i), '\n');
-      for (; i < j; ++i) {
-        const int32_t h = order[i].second;
+      size_value(static_cast<int64_t>(j - i0), '\n');
+      for (size_t i = i0; i < j; ++i) {
+        const int32_t h = groups.order[i];
         if (binary) {
           std::array<uint64_t, 9> row;
           row[0] = static_cast<uint64_t>(h) + 1;

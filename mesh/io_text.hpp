@@ -295,6 +295,18 @@ bool items_sort_by_permutation_ids(std::vector<T>& items, std::vector<int64_t>& 
 /// face shared by more than two hexes (message names the face's nodes, 0-based).
 void mesh_check_read(const HexMesh& mesh, const std::string& path);
 
+/// Hexes grouped by block_id, for the writers that store one block per id (Exodus element
+/// blocks, Gmsh volume entities, Abaqus element sets): `ids` ascending and distinct; the hexes of
+/// ids[b] are order[starts[b] .. starts[b + 1]), ascending. Without a block_id attribute every
+/// hex is in one block `default_id`; no hexes, no blocks. A counting sort when the ids span at
+/// most the hex count (+1024), a sort of (id, hex) pairs otherwise.
+struct HexBlocks {
+  std::vector<int32_t> ids;
+  std::vector<int32_t> order;
+  std::vector<size_t> starts;  ///< ids.size() + 1 entries
+};
+HexBlocks hex_blocks_group(const HexMesh& mesh, int32_t default_id);
+
 /// `v` with its bytes in big-endian order (VTK legacy binary), for 2-, 4- and 8-byte numbers.
 template <class T>
 T value_big_endian(T v) {

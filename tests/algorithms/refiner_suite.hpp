@@ -73,6 +73,13 @@ using RefinerFn = std::function<RefineResult(const HexMesh&, const Targets&, con
 
 /// Options with the thesis' node placement (every new node at its parent's trilinear map of the
 /// template's position): for the tests of the thesis' numbers and of exact geometry.
+/// Every hex of `m` as targets (full refinement).
+inline Targets targets_all_hexes(const HexMesh& m) {
+  Targets t;
+  for (int32_t h = 0; h < m.hex_count(); ++h) t.hexes.push_back(h);
+  return t;
+}
+
 inline RefineOptions refine_options_trilinear() {
   RefineOptions o;
   o.placement.method = PlacementMethod::trilinear;

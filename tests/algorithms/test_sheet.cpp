@@ -103,12 +103,6 @@ void expect_conformal_brick(const HexMesh& m, int nx, int ny, int nz) {
   expect_conformal_box(m, Eigen::Vector3d::Zero(), Eigen::Vector3d(nx, ny, nz));
 }
 
-Targets all_hexes(const HexMesh& m) {
-  Targets t;
-  for (int32_t h = 0; h < m.hex_count(); ++h) t.hexes.push_back(h);
-  return t;
-}
-
 // The thesis' L-shaped case: hexes on the x-min and z-min surfaces of a 10x10x10 brick.
 Targets l_shaped_targets(int n) {
   Targets t;
@@ -208,11 +202,12 @@ TEST_P(FullBrick, TwentySevenPerHexThroughThreeRounds) {
   const int n = GetParam();
   const HexMesh m = fixture_brick(n, n, n);
   std::vector<int64_t> round_hexes;
-  const RefineResult r = sheet_refine(m, all_hexes(m), {}, [&](const HexMesh& inter, int round) {
-    EXPECT_EQ(round, static_cast<int>(round_hexes.size()));
-    round_hexes.push_back(inter.hex_count());
-    expect_conformal_brick(inter, n, n, n);  // conformal after every round
-  });
+  const RefineResult r =
+      sheet_refine(m, targets_all_hexes(m), {}, [&](const HexMesh& inter, int round) {
+        EXPECT_EQ(round, static_cast<int>(round_hexes.size()));
+        round_hexes.push_back(inter.hex_count());
+        expect_conformal_brick(inter, n, n, n);  // conformal after every round
+      });
   const int64_t n3 = int64_t(n) * n * n;
   EXPECT_EQ(round_hexes, (std::vector<int64_t>{3 * n3, 9 * n3, 27 * n3}));
   EXPECT_EQ(r.mesh.hex_count(), 27 * n3);
@@ -547,8 +542,8 @@ TEST(SheetRefine, InvertedInputIsRefusedByBothPaths) {
 
 TEST(SheetVsSelective, FullBrickSameCountAndQuality) {
   const HexMesh m = fixture_brick(4, 4, 4);
-  const RefineResult sheet = sheet_refine(m, all_hexes(m), {});
-  SELECTIVE_OR_SKIP(selective, m, all_hexes(m), RefineOptions{});
+  const RefineResult sheet = sheet_refine(m, targets_all_hexes(m), {});
+  SELECTIVE_OR_SKIP(selective, m, targets_all_hexes(m), RefineOptions{});
   EXPECT_EQ(sheet.mesh.hex_count(), selective.mesh.hex_count());
   EXPECT_NEAR(mesh_check(sheet.mesh).min_scaled_jacobian,
               mesh_check(selective.mesh).min_scaled_jacobian, 1e-12);

@@ -24,12 +24,6 @@
 namespace hexrefine {
 namespace {
 
-Targets all_hexes(const HexMesh& m) {
-  Targets t;
-  for (int32_t h = 0; h < m.hex_count(); ++h) t.hexes.push_back(h);
-  return t;
-}
-
 // A ring of `segments` hexes with a 1x1 cross-section turned by 90 degrees once around: the
 // dual sheet of the cross-section edges closes onto itself with its two directions swapped, so
 // it crosses itself in every hex.
@@ -70,10 +64,11 @@ TEST(SheetRefine, TwistedRingFullyRefinedThroughTheSelfIntersection) {
   // once (1-9), then the ring direction's pass (1-3): 27 per hex, 9 + 27 created per hex.
   const HexMesh ring = twisted_ring(8);
   std::vector<int64_t> round_hexes;
-  const RefineResult r = sheet_refine(ring, all_hexes(ring), {}, [&](const HexMesh& inter, int) {
-    round_hexes.push_back(inter.hex_count());
-    EXPECT_TRUE(mesh_check(inter).valid());
-  });
+  const RefineResult r =
+      sheet_refine(ring, targets_all_hexes(ring), {}, [&](const HexMesh& inter, int) {
+        round_hexes.push_back(inter.hex_count());
+        EXPECT_TRUE(mesh_check(inter).valid());
+      });
   EXPECT_EQ(round_hexes, (std::vector<int64_t>{72, 216}));
   EXPECT_EQ(r.mesh.hex_count(), 216);
   EXPECT_EQ(r.stats.hexes_created, 8 * 9 + 72 * 3);
@@ -113,7 +108,7 @@ TEST(SheetRefine, GeneratedTwistedRing) {
   for (const auto& s : dual.hex_sheet) crossing += s[0] == s[1] || s[1] == s[2] || s[0] == s[2];
   ASSERT_GT(crossing, 0);
   // Whole ring: every hex fully refined, through the self-intersections.
-  const RefineResult full = sheet_refine(ring, all_hexes(ring), refine_options_trilinear());
+  const RefineResult full = sheet_refine(ring, targets_all_hexes(ring), refine_options_trilinear());
   EXPECT_EQ(full.mesh.hex_count(), 27 * ring.hex_count());
   EXPECT_EQ(full.stats.self_intersection_cases, crossing);
   EXPECT_TRUE(mesh_check(full.mesh).valid());

@@ -212,6 +212,23 @@ TEST(IoReadAll, ReadsEmptyAndMultiPieceFilesWhole) {
   EXPECT_THROW(io_detail::file_read_all((dir / "missing").string()), InputError);
 }
 
+TEST(HexBlocksGroup, GroupsByBlockIdAscendingWithDenseAndWideIds) {
+  HexMesh m = fixture_brick(3, 2, 1);                                         // 6 hexes
+  EXPECT_EQ(io_detail::hex_blocks_group(m, 5).ids, std::vector<int32_t>{5});  // no block_id
+  auto& block = mesh_attribute(m, attribute_block_id);
+  for (const std::vector<int32_t>& ids :
+       {std::vector<int32_t>{2, -1, 2, -5, -1, 2},
+        std::vector<int32_t>{INT32_MAX, -1, INT32_MAX, INT32_MIN, -1, INT32_MAX}}) {
+    block = ids;  // the second spans 2^32 ids: the sorting path
+    const io_detail::HexBlocks g = io_detail::hex_blocks_group(m, 0);
+    ASSERT_EQ(g.ids.size(), 3u);
+    EXPECT_EQ(g.ids, (std::vector<int32_t>{ids[3], ids[1], ids[0]}));
+    EXPECT_EQ(g.order, (std::vector<int32_t>{3, 1, 4, 0, 2, 5}));
+    EXPECT_EQ(g.starts, (std::vector<size_t>{0, 1, 3, 6}));
+  }
+  EXPECT_TRUE(io_detail::hex_blocks_group(HexMesh{}, 1).ids.empty());
+}
+
 TEST(IoFileBytes, MapsRegularFilesAndReadsPipes) {
   const auto dir = test_temp_dir("io_file_bytes");
   std::string big(300000, '\0');

@@ -64,6 +64,14 @@ bool template_is_boxes(const HexTemplate& t) {
   return true;
 }
 
+/// Unit normal of a patch from its diagonals; zero for a degenerate patch.
+Eigen::Vector3d quad_unit_normal(const Quad& q) {
+  const Eigen::Vector3d cross = (q[2] - q[0]).cross(q[3] - q[1]);
+  const double size2 = std::max((q[2] - q[0]).squaredNorm(), (q[3] - q[1]).squaredNorm());
+  return cross.norm() > 1e-12 * size2 ? Eigen::Vector3d(cross.normalized())
+                                      : Eigen::Vector3d::Zero();
+}
+
 /// The template node behind a new node: the use, and the plan node of its first active child.
 struct NodeOrigin {
   int32_t use = -1;
@@ -73,7 +81,8 @@ struct NodeOrigin {
 }  // namespace
 
 std::optional<NodeSlide> ReferenceSlides::at(const Eigen::Vector3d& x,
-                                             std::span<const int32_t> input_hexes) {
+                                             std::span<const int32_t> input_hexes,
+                                             double feature_cos) {
   int32_t best = -1;
   QuadProjection projection;
   for (int32_t h : input_hexes)
@@ -105,11 +114,100 @@ std::optional<NodeSlide> ReferenceSlides::at(const Eigen::Vector3d& x,
   // The patch side: v = 0 (q0 q1), u = 1 (q1 q2), v = 1 (q2 q3), u = 0 (q3 q0).
   const int side = v_rim ? (projection.v < 0.5 ? 0 : 2) : (projection.u > 0.5 ? 1 : 3);
   const Quad& q = reference_.patches[best];
+  if (feature_cos > -1) {
+    // The other patch on this side, if the surface does not bend there by more than allowed.
+    const Eigen::Vector3d normal = quad_unit_normal(q);
+    for (int32_t h : input_hexes)
+      for (int32_t k = reference_.hex_patch_offsets[h]; k < reference_.hex_patch_offsets[h + 1];
+           ++k) {
+        const int32_t p = reference_.hex_patches[k];
+        const Quad& o = reference_.patches[p];
+        if (p == best || std::find(o.begin(), o.end(), q[side]) == o.end() ||
+            std::find(o.begin(), o.end(), q[(side + 1) % 4]) == o.end())
+          continue;
+        const Eigen::Vector3d other = quad_unit_normal(o);
+        if (normal.isZero() || other.isZero() || normal.dot(other) < feature_cos) break;
+        slide.kind = SlideKind::patches;
+        slide.count = 2;
+        for (const int32_t both : {std::min(best, p), std::max(best, p)}) {
+          const auto [it, inserted] =
+              patch_copy_.try_emplace(both, static_cast<int32_t>(geometry_.patches.size()));
+          if (inserted) geometry_.patches.push_back(reference_.patches[both]);
+          geometry_.items.push_back(it->second);
+        }
+        return slide;
+      }
+  }
   const auto [it, inserted] =
       rim_segment_.try_emplace(4 * best + side, static_cast<int32_t>(geometry_.segments.size()));
   if (inserted) geometry_.segments.push_back({q[side], q[(side + 1) % 4]});
   slide.kind = SlideKind::segment;
   geometry_.items.push_back(it->second);
+  return slide;
+}
+
+std::optional<NodeSlide> ReferenceSlides::at_input_node(const Eigen::Vector3d& x,
+                                                        std::span<const int32_t> input_hexes,
+                                                        double feature_cos) {
+  // The sides at x of the patches cornered at x: (patch, side, its other end, patch normal).
+  struct Side {
+    int32_t patch;
+    int side;
+    Eigen::Vector3d other, normal;
+  };
+  std::vector<Side> sides;
+  std::vector<int32_t> patches;
+  for (int32_t h : input_hexes)
+    for (int32_t k = reference_.hex_patch_offsets[h]; k < reference_.hex_patch_offsets[h + 1];
+         ++k) {
+      const int32_t p = reference_.hex_patches[k];
+      const Quad& q = reference_.patches[p];
+      const int at = static_cast<int>(std::find(q.begin(), q.end(), x) - q.begin());
+      if (at == 4 || std::find(patches.begin(), patches.end(), p) != patches.end()) continue;
+      const Eigen::Vector3d normal = quad_unit_normal(q);
+      if (normal.isZero()) return std::nullopt;
+      patches.push_back(p);
+      sides.push_back({p, at, q[(at + 1) % 4], normal});
+      sides.push_back({p, (at + 3) % 4, q[(at + 3) % 4], normal});
+    }
+  if (patches.empty()) return std::nullopt;
+  const auto before = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  };
+  std::sort(sides.begin(), sides.end(),
+            [&](const Side& a, const Side& b) { return before(a.other, b.other); });
+  std::vector<const Side*> feature;
+  for (size_t i = 0; i < sides.size();) {
+    size_t j = i;
+    while (j < sides.size() && sides[j].other == sides[i].other) ++j;
+    if (j - i != 2 || sides[i].normal.dot(sides[i + 1].normal) < feature_cos)
+      feature.push_back(&sides[i]);
+    i = j;
+  }
+  NodeSlide slide;
+  slide.first = static_cast<int32_t>(geometry_.items.size());
+  if (feature.empty()) {
+    std::sort(patches.begin(), patches.end());
+    for (int32_t p : patches) {
+      const auto [it, inserted] =
+          patch_copy_.try_emplace(p, static_cast<int32_t>(geometry_.patches.size()));
+      if (inserted) geometry_.patches.push_back(reference_.patches[p]);
+      geometry_.items.push_back(it->second);
+    }
+    slide.kind = SlideKind::patches;
+  } else if (feature.size() == 2) {
+    for (const Side* s : feature) {
+      const Quad& q = reference_.patches[s->patch];
+      const auto [it, inserted] = rim_segment_.try_emplace(
+          4 * s->patch + s->side, static_cast<int32_t>(geometry_.segments.size()));
+      if (inserted) geometry_.segments.push_back({q[s->side], q[(s->side + 1) % 4]});
+      geometry_.items.push_back(it->second);
+    }
+    slide.kind = SlideKind::segments;
+  } else {
+    return std::nullopt;
+  }
+  slide.count = static_cast<int32_t>(geometry_.items.size()) - slide.first;
   return slide;
 }
 

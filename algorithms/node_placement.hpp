@@ -85,8 +85,20 @@ class ReferenceSlides {
   /// refined hexes around it): on the nearest of their input patches, strictly inside it (a
   /// patch slide), on one of its sides (a segment slide along that side, which two input faces
   /// share or which is the rim of the boundary), or nullopt at a patch corner or when no patch
-  /// is found (the node stays).
-  std::optional<NodeSlide> at(const Eigen::Vector3d& x, std::span<const int32_t> input_hexes);
+  /// is found (the node stays). With `feature_cos` > -1 (smoothing), a node on a side that two
+  /// of those patches share, their unit normals' dot product at least `feature_cos`, slides on
+  /// both patches instead (a patches slide: the side is no feature of the input's surface).
+  std::optional<NodeSlide> at(const Eigen::Vector3d& x, std::span<const int32_t> input_hexes,
+                              double feature_cos = -2);
+
+  /// The slide of an input node at x (a corner of input patches, not yet moved) on the boundary
+  /// of the input hexes `input_hexes` (those around it), for smoothing: the patch sides at x are
+  /// feature sides when they lie on other than two patches or when the patches' unit normals
+  /// (of their diagonals) have a dot product below `feature_cos`. No feature side: the node
+  /// slides on the union of its patches (a patches slide); two: along those two sides (a
+  /// segments slide, the feature curve); otherwise, or at a degenerate patch, nullopt (stays).
+  std::optional<NodeSlide> at_input_node(const Eigen::Vector3d& x,
+                                         std::span<const int32_t> input_hexes, double feature_cos);
 
  private:
   const BoundaryReference& reference_;

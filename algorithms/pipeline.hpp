@@ -14,8 +14,9 @@
 /// the input hexes they descend from; nothing is returned or written. With an ablation switch the
 /// result may be non-conformal by design and is returned with the checker's counts.
 /// Smoothing (optional) moves the nodes of the refined region and two layers around it
-/// (algorithms/smoothing.hpp), boundary nodes within the input faces they subdivide, and the
-/// result is checked against the input again the same way.
+/// (algorithms/smoothing.hpp), boundary nodes on the input's boundary surface (the input's own
+/// boundary nodes too, over the input faces around them), and the result is checked against the
+/// input again the same way.
 
 #include <cstdint>
 #include <iosfwd>

@@ -12,10 +12,16 @@
 ///     the whole mesh, so the cost is linear in the region.
 ///  2. Boundary nodes, from the boundary faces of that part (a face holding a region node has
 ///     both its hexes in it, so its boundary status is the whole mesh's):
-///     - with a reference (the input of a refinement): a node of the input stays; a node the
-///       refinement made slides on the input face or edge it subdivides (ReferenceSlides, as in
-///       node placement), so the refined boundary faces keep subdividing the input's faces and the
-///       checker's comparison with the input still holds;
+///     - with a reference (the input of a refinement): a node the refinement made slides on the
+///       input face or edge it subdivides (ReferenceSlides, as in node placement); a node of the
+///       input slides on the union of the input's boundary patches around it, or along the two
+///       feature sides at it (patch sides whose patches meet at more than the feature angle, or
+///       any angle when every input face is planar: there the facets are the geometry), and
+///       stays at a corner (ReferenceSlides::at_input_node). Every boundary node stays on the
+///       input's boundary surface; a boundary face may then straddle two input faces, which the
+///       checker accepts when its corners lie on the input surface (conformity.hpp). The
+///       transition children of a boundary parent are where refinement loses most quality,
+///       and the input's own boundary nodes are half of their corners;
 ///     - without one: a boundary node slides on the boundary quads around it (their bilinear
 ///       patches at the start: projection onto the nearest), a node on exactly two feature edges
 ///       slides along them, other feature nodes (corners, ends of feature curves) stay.
@@ -216,6 +222,18 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
     for (int32_t f : topology_boundary_faces(topology))
       for (int32_t n : topology.face_nodes[f]) boundary[n] = 1;
     ReferenceSlides slides(*options.reference, problem.geometry);
+    // On a planar-faced input every kink between its faces is its geometry (the checker holds
+    // such an output to the input's volume and area): input nodes slide only across flat
+    // sides there. On a curved (warped) input the feature angle decides.
+    bool planar_faced = true;
+    for (const Quad& q : options.reference->patches)
+      if (quad_relative_warp(q) > 1e-12) {
+        planar_faced = false;
+        break;
+      }
+    const double input_feature_cos =
+        planar_faced ? 1 - 1e-9
+                     : std::cos(options.feature_angle_degrees * std::numbers::pi / 180.0);
     std::vector<int32_t> around;
     std::vector<std::pair<int32_t, NodeSlide>> movable;
     for (int32_t n = 0; n < sub.mesh.point_count(); ++n) {
@@ -223,12 +241,14 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
       const int32_t node = sub.node_of[n];
       NodeSlide slide;
       if (boundary[n]) {
-        if (node < options.reference_nodes) continue;  // an input node on the boundary stays
         around.clear();
         for (int32_t h : node_hexes(topology, n)) around.push_back((*parent)[part[h]]);
         std::sort(around.begin(), around.end());
         around.erase(std::unique(around.begin(), around.end()), around.end());
-        const std::optional<NodeSlide> s = slides.at(mesh.points[node], around);
+        const std::optional<NodeSlide> s =
+            node < options.reference_nodes
+                ? slides.at_input_node(mesh.points[node], around, input_feature_cos)
+                : slides.at(mesh.points[node], around, input_feature_cos);
         if (!s) continue;
         slide = *s;
       }

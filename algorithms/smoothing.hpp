@@ -62,11 +62,11 @@ struct SmoothOptions {
   /// 0.5, the lower end of Verdict's acceptable range): a region of acceptable hexes costs one
   /// pass over its nodes, the work goes where quality is poor.
   double visit_below = 0.5;
-  /// The input of a refinement (refine --smooth): boundary nodes the refinement made slide only
-  /// within the input face or edge they subdivide (the refined mesh keeps subdividing the input's
-  /// boundary faces, as the checker verifies against the input), the input's own boundary nodes
-  /// stay. `reference_nodes` is the input's node count, the mesh's parent_hex attribute names the
-  /// input hexes. nullptr: boundary nodes slide on the mesh's own boundary quads (SmoothNodeKind).
+  /// The input of a refinement (refine --smooth): every boundary node stays on the input's
+  /// boundary surface: one the refinement made slides within the input face or edge it
+  /// subdivides, one of the input (id < `reference_nodes`) on the input faces around it or along
+  /// its feature curve (smoothing.cpp). The mesh's parent_hex attribute names the input hexes.
+  /// nullptr: boundary nodes slide on the mesh's own boundary quads (SmoothNodeKind).
   const BoundaryReference* reference = nullptr;
   int32_t reference_nodes = 0;
 };

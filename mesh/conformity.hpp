@@ -8,10 +8,17 @@
 /// - non-manifold face: a quad (same four nodes) used by more than two hexes.
 /// - non-conformal face: a boundary face (used by one hex) that is not a true boundary face.
 ///   * With a reference (the mesh before refinement): a boundary face whose four corners and
-///     centroid do not all lie on one boundary face of the reference. Refinement must subdivide
-///     the reference's boundary faces, so any other boundary face is one side of a gap between
-///     two hexes that should share a face (the T-junction faces of a 1-8 split beside an unsplit
-///     hex: the big face and its four small faces are all non-conformal).
+///     centroid do not all lie on one boundary face of the reference, and that does not lie
+///     across reference faces either. Refinement must subdivide the reference's boundary faces,
+///     so any other boundary face is one side of a gap between two hexes that should share a
+///     face (the T-junction faces of a 1-8 split beside an unsplit hex: the big face and its
+///     four small faces are all non-conformal). "Across": smoothing slides the input's own
+///     boundary nodes over the input's faces (smoothing.cpp), so a face may span two of them;
+///     it lies across them when each corner lies on a reference face whose normal is within
+///     mesh_check_across_angle_degrees of the face's (a gap face through a one-hex-thick plate
+///     has its corners on the surface too, but stands across it) and its centroid is within
+///     mesh_check_across_chord x its diameter of one of those faces (the sag of a chord over a
+///     bend of at most the smoothing's feature angle).
 ///   * Without a reference: a boundary face whose centroid lies on another boundary face of the
 ///     same mesh (the two coincident sides of a gap). A gap that does not leave coincident faces
 ///     (e.g. one hex moved away from its neighbour) cannot be told from true boundary without a
@@ -53,6 +60,10 @@ namespace hexrefine {
 
 /// Relative distance under which a point counts as lying on a boundary face.
 inline constexpr double mesh_check_surface_tolerance = 1e-6;
+/// A boundary face across reference faces: largest angle between its normal and theirs, and
+/// largest distance of its centroid from them relative to its diameter (see above).
+inline constexpr double mesh_check_across_angle_degrees = 45;
+inline constexpr double mesh_check_across_chord = 0.1;
 /// Relative volume and boundary-area error allowed for planar-faced references.
 inline constexpr double mesh_check_geometry_tolerance = 1e-9;
 /// Relative distance (to the bounding-box diagonal) under which two nodes are duplicates.

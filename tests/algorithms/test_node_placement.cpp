@@ -76,6 +76,48 @@ TEST(ReferenceSlides, FaceInteriorSlidesOnItsPatchEdgesAlongTheirSideCornersStay
   EXPECT_EQ(g.patches.size(), 1u);
 }
 
+TEST(ReferenceSlides, InputNodeSlidesOnItsPatchesAlongItsFeatureCurveOrStays) {
+  // A 2x2x1 brick whose top is bent up along x = 1 by 10 degrees (a curved, non-planar input
+  // would slide across it; here every face is planar, so the caller passes a strict angle).
+  HexMesh m = fixture_brick(2, 2, 1);
+  const double rise = std::tan(10.0 * std::acos(-1.0) / 180.0);
+  for (Eigen::Vector3d& x : m.points)
+    if (x.z() == 1 && x.x() == 2) x.z() += rise;
+  const BoundaryReference r = boundary_reference_build(m, topology_build(m));
+  SlideGeometry g;
+  ReferenceSlides slides(r, g);
+  const std::vector<int32_t> all = {0, 1, 2, 3};
+  const double feature_cos_30 = std::cos(30.0 * std::acos(-1.0) / 180.0);
+  // Top centre (1, 1, 1): four top patches, the 10-degree bend is no feature at 30 degrees.
+  const std::optional<NodeSlide> top = slides.at_input_node({1, 1, 1}, all, feature_cos_30);
+  ASSERT_TRUE(top);
+  EXPECT_EQ(top->kind, SlideKind::patches);
+  EXPECT_EQ(top->count, 4);
+  // With the strict angle (planar-faced input) the bend is a feature curve: along it.
+  const std::optional<NodeSlide> strict = slides.at_input_node({1, 1, 1}, all, 1 - 1e-9);
+  ASSERT_TRUE(strict);
+  EXPECT_EQ(strict->kind, SlideKind::segments);
+  EXPECT_EQ(strict->count, 2);
+  for (int k = 0; k < 2; ++k) {
+    const auto& s = g.segments[g.items[strict->first + k]];
+    EXPECT_NEAR(std::abs((s[1] - s[0]).normalized().y()), 1.0, 1e-15);  // along y at x = 1
+  }
+  // Mid side (1, 0, 0.5 is no node; (1, 0, 0) is on the bottom rim): the rim is its curve.
+  const std::optional<NodeSlide> rim = slides.at_input_node({1, 0, 0}, all, feature_cos_30);
+  ASSERT_TRUE(rim);
+  EXPECT_EQ(rim->kind, SlideKind::segments);
+  EXPECT_FALSE(slides.at_input_node({0, 0, 0}, all, feature_cos_30));      // a corner stays
+  EXPECT_FALSE(slides.at_input_node({0.5, 0.5, 0}, all, feature_cos_30));  // no input node
+  // A new node on the bend (1, 0.5, 1): along it for placement; on both patches for smoothing
+  // when the bend is no feature, along it again when it is.
+  EXPECT_EQ(slides.at({1, 0.5, 1}, all)->kind, SlideKind::segment);
+  const std::optional<NodeSlide> across = slides.at({1, 0.5, 1}, all, feature_cos_30);
+  ASSERT_TRUE(across);
+  EXPECT_EQ(across->kind, SlideKind::patches);
+  EXPECT_EQ(across->count, 2);
+  EXPECT_EQ(slides.at({1, 0.5, 1}, all, 1 - 1e-9)->kind, SlideKind::segment);
+}
+
 TEST(NodePlacement, ParallelepipedsRefinedByBoxesAreLeftAlone) {
   // Children of a parallelepiped by 1-27 have its scaled Jacobian: nothing to do, nothing
   // evaluated.

@@ -146,6 +146,52 @@ TEST(Conformity, BoundaryNodeMovedOffReferenceSurface) {
   EXPECT_TRUE(mesh_check(m).conformal);
 }
 
+TEST(Conformity, FacesAcrossReferenceFacesAreOnTheSurface) {
+  // Smoothing slides an input boundary node over the input's faces: the top edge x = 1 of a
+  // 2x1x1 brick moved to x = 1.3 leaves the top and side faces of both hexes across two
+  // reference faces each, on the same planes: conformal, and the planar geometry preserved.
+  const HexMesh reference = fixture_brick(2, 1, 1);
+  HexMesh m = reference;
+  int moved = 0;
+  for (Eigen::Vector3d& x : m.points)
+    if (x.x() == 1 && x.z() == 1) {
+      x.x() = 1.3;
+      ++moved;
+    }
+  ASSERT_EQ(moved, 2);
+  const MeshCheckReport r = mesh_check(m, &reference);
+  EXPECT_EQ(r.non_conformal_faces, 0);
+  EXPECT_TRUE(r.conformal);
+  EXPECT_TRUE(r.geometry_preserved);
+  EXPECT_TRUE(r.valid());
+  // Off the surface is still off it: the same edge raised by 0.05 (a bulge, not a slide).
+  HexMesh bulge = m;
+  for (Eigen::Vector3d& x : bulge.points)
+    if (x.x() == 1.3) x.z() = 1.05;
+  EXPECT_EQ(mesh_check(bulge, &reference).non_conformal_faces, 6);
+}
+
+TEST(Conformity, GapThroughAOneHexPlateIsNonConformalThoughItsCornersAreOnTheSurface) {
+  // Two hexes of a thin plate that should share the face x = 1 but have their own nodes there:
+  // the two faces of the gap have every corner on the reference surface (top, bottom, sides),
+  // but they stand across it.
+  const HexMesh reference = fixture_brick(2, 1, 1);
+  HexMesh m;
+  for (int h = 0; h < 2; ++h)
+    for (int v = 0; v < 8; ++v) {
+      m.points.push_back(reference.points[reference.hexes[h][v]]);
+      m.hexes.resize(h + 1);
+      m.hexes[h][v] = static_cast<int32_t>(m.points.size()) - 1;
+    }
+  for (Eigen::Vector3d& x : m.points) x.z() *= 0.1;
+  HexMesh plate = reference;
+  for (Eigen::Vector3d& x : plate.points) x.z() *= 0.1;
+  const MeshCheckReport r = mesh_check(m, &plate);
+  EXPECT_EQ(r.non_conformal_faces, 2);
+  EXPECT_FALSE(r.conformal);
+  EXPECT_EQ(r.duplicate_nodes, 4);
+}
+
 TEST(Conformity, NonPlanarReferenceOnlyReportsGeometryErrors) {
   HexMesh reference = fixture_brick(1, 1, 1);
   reference.points[6].z() = 1.2;  // warps the top, +x and +y faces

@@ -178,9 +178,34 @@ json real_mesh_study_cases(const std::vector<std::string>& mesh_files,
         cases.push_back(c);
       }
   }
+  // Anisotropic boxes: parents whose scaled Jacobian is 1 but whose edges differ by a factor a,
+  // around one target hex in the middle of a 5x5x5 brick (long: boxes 1 x 1 x a, the target's
+  // neighbours above and below get a transition template in their small face; flat: a x a x 1).
+  for (const double a : {1.0, 1.5, 2.0, 3.0, 4.0})
+    for (const char* orientation : {"long", "flat"}) {
+      const bool flat = std::string(orientation) == "flat";
+      if (a == 1.0 && flat) continue;
+      const std::array<double, 3> size = flat ? std::array{a, a, 1.0} : std::array{1.0, 1.0, a};
+      const std::string select = "sphere:" + number_text(size[0] / 2) + "," +
+                                 number_text(size[1] / 2) + "," + number_text(size[2] / 2) +
+                                 ",0.01";
+      for (const char* placement : {"trilinear", "optimized"}) {
+        json c =
+            make_case("aspect-" + number_text(a) + "-" + orientation + "/" + placement,
+                      json{{"generate", "brick"}, {"dims", {5, 5, 5}}, {"size", size}}, {select},
+                      {{"study", "anisotropy"},
+                       {"aspect", a},
+                       {"orientation", orientation},
+                       {"placement", placement}});
+        c["smooth"] = true;
+        c["options"] = {{"placement", placement}};
+        cases.push_back(c);
+      }
+    }
   return json{{"description",
                "Real-mesh study (hexrefine study): every shared real mesh x region kind x both "
-               "methods x trilinear/optimized placement, smoothed; see results/real_meshes.md"},
+               "methods x trilinear/optimized placement, smoothed; and one target hex among "
+               "anisotropic boxes; see results/real_meshes.md"},
               {"cases", cases},
               {"output", output}};
 }

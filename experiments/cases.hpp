@@ -40,7 +40,9 @@ nlohmann::json thesis_suite_cases(bool quick, const std::string& meshes_dir,
 /// blob (2 % of the hexes, at least 20, two seeds), boundary surface (the largest patch at 30
 /// degrees), scattered hexes (2 %, two seeds) and two passes with the buffer (a ball of 0.1 of the
 /// diagonal), plus rockerarm.mesh's sphere:0,0,0,5; both methods, trilinear and optimized
-/// placement, smoothed (the record keeps the unsmoothed check too).
+/// placement, smoothed (the record keeps the unsmoothed check too). Then the anisotropy cases
+/// (tags study "anisotropy", aspect, orientation): one target hex in the middle of a 5x5x5 brick
+/// of boxes 1 x 1 x a ("long") or a x a x 1 ("flat"), a in 1, 1.5, 2, 3, 4, the same options.
 nlohmann::json real_mesh_study_cases(const std::vector<std::string>& mesh_files,
                                      const std::string& meshes_read_dir,
                                      const std::string& meshes_dir, const std::string& output);

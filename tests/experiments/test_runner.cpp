@@ -423,6 +423,30 @@ TEST(RunMeshFileName, ReplacesPathCharacters) {
   EXPECT_EQ(run_mesh_file_name("a b:c", "sheet"), "a_b_c.sheet.vtu");
 }
 
+TEST(RealMeshStudy, IsAValidCaseFileWithEveryRegionKindAndTheAnisotropyCases) {
+  const std::string meshes = std::string(HEXREFINE_SHARED_DIR) + "/meshes";
+  const json root =
+      real_mesh_study_cases({"rockerarm.mesh", "sphere_sculpt.e"}, meshes, meshes, "r.jsonl");
+  const RunPlan plan = run_plan_parse(root, "study.json", "/");
+  // 7 region kinds per mesh, rockerarm's issue ball, x 2 placements; then 9 box shapes (aspect
+  // 1 once, 1.5, 2, 3, 4 long and flat) x 2 placements.
+  EXPECT_EQ(plan.cases.size(), (7 + 1 + 7) * 2u + 9 * 2u);
+  int anisotropy = 0;
+  for (const RunCase& c : plan.cases) {
+    EXPECT_TRUE(c.smooth) << c.name;
+    EXPECT_EQ(c.methods, (std::vector<std::string>{"selective", "sheet"})) << c.name;
+    if (c.tags.value("study", "") != "anisotropy") continue;
+    ++anisotropy;
+    EXPECT_EQ(c.mesh["generate"], "brick") << c.name;
+    EXPECT_EQ(c.mesh["dims"], json({5, 5, 5})) << c.name;
+    ASSERT_EQ(c.select.size(), 1u);
+    EXPECT_EQ(c.select[0].rfind("sphere:", 0), 0u) << c.name;
+  }
+  EXPECT_EQ(anisotropy, 18);
+  EXPECT_EQ(plan.cases.back().name, "aspect-4-flat/optimized");
+  EXPECT_EQ(plan.cases.back().mesh["size"], json({4.0, 4.0, 1.0}));
+}
+
 TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
   const std::string meshes = std::string(HEXREFINE_SHARED_DIR) + "/meshes";
   for (const bool quick : {true, false}) {

@@ -33,7 +33,7 @@ std::array<int32_t, 3> face_other_nodes(const HexCell& c, int lf, int32_t lowest
 
 }  // namespace
 
-HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads) {
+HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool neighbors) {
   const int32_t hexes = mesh.hex_count();
   if (hexes > hex_face_adjacency_max_hexes)
     throw OperationError("the mesh has " + std::to_string(hexes) +
@@ -58,7 +58,7 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads) {
       slots[bucket_end[face_lowest_node(mesh.hexes[h], lf)]++] = static_cast<uint32_t>(h) * 6 + lf;
 
   HexFaceAdjacency a;
-  a.hex_neighbors.resize(static_cast<size_t>(hexes));
+  if (neighbors) a.hex_neighbors.resize(static_cast<size_t>(hexes));
   // Node ranges are matched independently; their boundary and non-manifold faces are
   // concatenated in range order, which is the sequential order.
   constexpr int64_t chunk_nodes = 1 << 15;
@@ -81,7 +81,7 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads) {
         for (uint32_t k = bucket_end[node + prefetch_distance - 1];
              k < bucket_end[node + prefetch_distance]; ++k) {
           __builtin_prefetch(&mesh.hexes[slots[k] / 6]);
-          __builtin_prefetch(&a.hex_neighbors[slots[k] / 6], 1);
+          if (neighbors) __builtin_prefetch(&a.hex_neighbors[slots[k] / 6], 1);
         }
       keys.clear();
       for (uint32_t k = first; k < bucket_end[node]; ++k) {
@@ -102,10 +102,10 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads) {
             continue;
           keys[j].matched = true;
           const int32_t h = static_cast<int32_t>(keys[j].slot / 6);
-          a.hex_neighbors[h][keys[j].slot % 6] = h0;
+          if (neighbors) a.hex_neighbors[h][keys[j].slot % 6] = h0;
           if (++users == 2) h1 = h;
         }
-        a.hex_neighbors[h0][keys[i].slot % 6] = h1;
+        if (neighbors) a.hex_neighbors[h0][keys[i].slot % 6] = h1;
         if (users == 1)
           boundary[chunk].push_back({h0, static_cast<int32_t>(keys[i].slot % 6)});
         else if (users > 2)

@@ -116,21 +116,26 @@ std::vector<HexAttribute> exodus_element_variables(
         ok = false;
         break;
       }
-      values.assign(static_cast<size_t>(n), 0.0);
-      const size_t start[2] = {0, 0}, extent[2] = {1, static_cast<size_t>(n)};
-      if (n > 0 && nc_get_vara_double(file.id, id, start, extent, values.data()) != NC_NOERR)
-        throw InputError(path + ": cannot read element variable '" + name + "' of block " + k +
-                         ": corrupt or truncated file");
-      for (double x : values) {
-        // netCDF returns its fill value for data missing from a truncated file.
-        if (x == 9.9692099683868690e+36)
-          throw InputError(path + ": element variable '" + name + "' of block " + k +
-                           " has an unwritten (netCDF fill) value: corrupt or truncated file");
-        if (!(x == std::floor(x) && x >= INT32_MIN && x <= INT32_MAX)) {
-          ok = false;
-          break;
+      // In chunks: a block's doubles would be twice the attribute's own int32 array.
+      for (int64_t first = 0; first < n && ok; first += static_cast<int64_t>(exodus_chunk)) {
+        const int64_t chunk = std::min<int64_t>(n - first, exodus_chunk);
+        values.resize(static_cast<size_t>(chunk));
+        const size_t start[2] = {0, static_cast<size_t>(first)},
+                     extent[2] = {1, static_cast<size_t>(chunk)};
+        if (nc_get_vara_double(file.id, id, start, extent, values.data()) != NC_NOERR)
+          throw InputError(path + ": cannot read element variable '" + name + "' of block " + k +
+                           ": corrupt or truncated file");
+        for (double x : values) {
+          // netCDF returns its fill value for data missing from a truncated file.
+          if (x == 9.9692099683868690e+36)
+            throw InputError(path + ": element variable '" + name + "' of block " + k +
+                             " has an unwritten (netCDF fill) value: corrupt or truncated file");
+          if (!(x == std::floor(x) && x >= INT32_MIN && x <= INT32_MAX)) {
+            ok = false;
+            break;
+          }
+          a.values.push_back(static_cast<int32_t>(x));
         }
-        a.values.push_back(static_cast<int32_t>(x));
       }
       if (!ok) break;
     }
@@ -224,11 +229,11 @@ HexMesh exodus_read(const std::string& path) {
                        std::to_string(element_map[e]) +
                        " in the element id map, expected >= 1 "
                        "(corrupt or truncated file)");
-  std::vector<int64_t> hex_ids;
   std::vector<int32_t> block;
   mesh.hexes.reserve(elems);
-  hex_ids.reserve(elems);
   block.reserve(elems);
+  // First element (0-based, file order) of each hex block, beside hex_blocks.
+  std::vector<int64_t> hex_block_first;
   std::vector<std::pair<int64_t, int64_t>> hex_blocks;  // (file-order block index, hex count)
   int64_t first_element = 0;
   for (int64_t b = 0; b < blocks; ++b) {
@@ -282,30 +287,37 @@ HexMesh exodus_read(const std::string& path) {
           }
           mesh.hexes.push_back(c);
           block.push_back(static_cast<int32_t>(block_id));
-          hex_ids.push_back(element_map[first_element + begin + e]);
         }
       }
       hex_blocks.push_back({b, count});
+      hex_block_first.push_back(first_element);
     }
     first_element += count;
   }
-  // Restore the written order when the hex ids are exactly 1..m.
+  // Restore the written order when the hex ids are exactly 1..m. The element map and the
+  // bookkeeping are released before the element variables are read (peak memory).
   const size_t m = mesh.hexes.size();
   std::vector<int32_t> slot(m);
-  bool permutation = true;
-  std::vector<char> seen(m, 0);
-  for (size_t i = 0; i < m && permutation; ++i) {
-    const int64_t t = hex_ids[i];
-    if (t < 1 || t > static_cast<int64_t>(m) || seen[t - 1])
-      permutation = false;
-    else
-      seen[t - 1] = 1, slot[i] = static_cast<int32_t>(t - 1);
+  bool permutation = true, identity = true;
+  {
+    std::vector<char> seen(m, 0);
+    size_t i = 0;
+    for (size_t hb = 0; hb < hex_blocks.size() && permutation; ++hb)
+      for (int64_t e = 0; e < hex_blocks[hb].second && permutation; ++e, ++i) {
+        const int64_t t = element_map[hex_block_first[hb] + e];
+        if (t < 1 || t > static_cast<int64_t>(m) || seen[t - 1])
+          permutation = false;
+        else
+          seen[t - 1] = 1, slot[i] = static_cast<int32_t>(t - 1);
+        identity = identity && t - 1 == static_cast<int64_t>(i);
+      }
+    identity = identity && permutation;
   }
+  std::vector<int64_t>().swap(element_map);
+  if (identity) std::vector<int32_t>().swap(slot);
   mesh.attributes.push_back({std::string(attribute_block_id), std::move(block)});
   for (HexAttribute& a : exodus_element_variables(path, hex_blocks))
     mesh.attributes.push_back(std::move(a));
-  bool identity = permutation;
-  for (size_t i = 0; i < m && identity; ++i) identity = slot[i] == static_cast<int32_t>(i);
   if (permutation && !identity) {
     std::vector<HexCell> hexes(m);
     for (size_t i = 0; i < m; ++i) hexes[slot[i]] = mesh.hexes[i];

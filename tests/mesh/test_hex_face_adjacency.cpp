@@ -53,6 +53,13 @@ TEST(HexFaceAdjacency, NonManifoldFaceGoesToItsLowestHex) {
   const HexFaceAdjacency a = hex_face_adjacency_build(m);
   ASSERT_EQ(a.nonmanifold_faces.size(), 1u);
   EXPECT_EQ(a.nonmanifold_faces[0].hex, 0);
+  // Without the neighbour array (a reader's manifold test): the same faces, no neighbours.
+  const HexFaceAdjacency lean = hex_face_adjacency_build(m, 2, false);
+  EXPECT_TRUE(lean.hex_neighbors.empty());
+  ASSERT_EQ(lean.nonmanifold_faces.size(), 1u);
+  EXPECT_EQ(lean.nonmanifold_faces[0].hex, 0);
+  EXPECT_EQ(lean.nonmanifold_faces[0].local_face, a.nonmanifold_faces[0].local_face);
+  EXPECT_EQ(lean.boundary_faces.size(), a.boundary_faces.size());
   // Hex 2 has hex 0's eight nodes: five faces pair it with hex 0, and on the face hexes 0, 1 and
   // 2 share, the third user points to the lowest: all six give hex 0.
   int to_hex0 = 0;

@@ -46,7 +46,8 @@ class StageClock {
     result_.stage_seconds[stage] += s;
     result_.stage_cpu_seconds[stage] += cpu - cpu_start_;
     if (verbose_)
-      *verbose_ << "hexrefine: " << stage << " " << std::fixed << std::setprecision(3) << s << " s"
+      *verbose_ << "hexrefine: " << stage << " " << std::fixed << std::setprecision(3) << s
+                << " s (peak so far " << static_cast<int64_t>(process_peak_memory_mb()) << " MB)"
                 << std::endl;
     if (progress_) *progress_ << "\r\033[K" << std::flush;
     start_ = Clock::now();

@@ -83,6 +83,15 @@ FileBytes::FileBytes(const std::string& path) {
   if (read_failed) throw InputError(path + ": read failed");
 }
 
+void FileBytes::release(std::string_view part) const {
+  if (map_ == nullptr || part.data() < map_ || part.data() + part.size() > map_ + size_) return;
+  const uintptr_t page = static_cast<uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(part.data()) + page - 1) / page * page;
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(part.data()) + part.size()) / page * page;
+  if (end > begin)
+    ::madvise(reinterpret_cast<void*>(begin), static_cast<size_t>(end - begin), MADV_DONTNEED);
+}
+
 FileBytes::~FileBytes() {
   if (map_ != nullptr) ::munmap(const_cast<char*>(map_), size_);
 }
@@ -245,10 +254,14 @@ HexMesh mesh_read(const std::string& path) {
       return io_detail::medit_read(path, io_detail::FileBytes(path).view());
     case MeshFormat::vtk_legacy:
       return io_detail::vtk_read(path, io_detail::FileBytes(path).view());
-    case MeshFormat::vtu:
-      return io_detail::vtu_read(path, io_detail::FileBytes(path).view());
-    case MeshFormat::gmsh:
-      return io_detail::gmsh_read(path, io_detail::FileBytes(path).view());
+    case MeshFormat::vtu: {
+      const io_detail::FileBytes file(path);
+      return io_detail::vtu_read(path, file.view(), &file);
+    }
+    case MeshFormat::gmsh: {
+      const io_detail::FileBytes file(path);
+      return io_detail::gmsh_read(path, file.view(), &file);
+    }
     case MeshFormat::exodus:
       return io_detail::exodus_read(path);
     case MeshFormat::abaqus:

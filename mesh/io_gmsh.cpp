@@ -453,7 +453,7 @@ void gmsh_element_data_read(GmshNumbers& in, GmshRead& g) {
 
 }  // namespace
 
-HexMesh gmsh_read(const std::string& path, std::string_view text) {
+HexMesh gmsh_read(const std::string& path, std::string_view text, const FileBytes* file) {
   TextCursor cursor(path, text);
   const GmshFormat f = gmsh_format_read(cursor);
   GmshNumbers in(cursor, f.binary, f.size_bytes);
@@ -461,6 +461,8 @@ HexMesh gmsh_read(const std::string& path, std::string_view text) {
   std::map<int64_t, int32_t> volume_physical;  // volume entity tag -> first physical tag
   bool have_nodes = false, have_elements = false;
   while (!cursor.at_end()) {
+    // What a section held is in the mesh being built once it is read: its bytes go.
+    if (file) file->release(text.substr(0, cursor.position()));
     const std::string_view section = cursor.token("a section");
     if (section == "$Entities" && f.v4) {
       gmsh_entities_read(in, volume_physical);

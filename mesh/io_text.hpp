@@ -41,6 +41,12 @@ class FileBytes {
   FileBytes(const FileBytes&) = delete;
   FileBytes& operator=(const FileBytes&) = delete;
   std::string_view view() const { return map_ ? std::string_view(map_, size_) : copy_; }
+  /// Tells the system that `part` (a slice of view()) has been consumed: the whole pages inside
+  /// it leave this process' resident memory (madvise MADV_DONTNEED). The bytes stay readable: a
+  /// private read-only mapping faults them in again from the file. A reader that has copied a
+  /// large array out of the file calls this so that the file and the copy do not both count in
+  /// its peak. Nothing happens for a copied (not mapped) file or a slice outside the mapping.
+  void release(std::string_view part) const;
 
  private:
   const char* map_ = nullptr;
@@ -348,11 +354,13 @@ void medit_write(const std::string& path, const HexMesh& mesh);
 HexMesh vtk_read(const std::string& path, std::string_view text);
 void vtk_write(const std::string& path, const HexMesh& mesh, const bool binary,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
-HexMesh vtu_read(const std::string& path, std::string_view text);
+/// `file`, when `text` is its view: large arrays read from it in place are released once copied.
+HexMesh vtu_read(const std::string& path, std::string_view text, const FileBytes* file = nullptr);
 void vtu_write(const std::string& path, const HexMesh& mesh,
                const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars,
                bool ascii, bool compress);
-HexMesh gmsh_read(const std::string& path, std::string_view text);
+/// `file`, when `text` is its view: each section's bytes are released once it is read.
+HexMesh gmsh_read(const std::string& path, std::string_view text, const FileBytes* file = nullptr);
 void gmsh_write(const std::string& path, const HexMesh& mesh, bool binary,
                 const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars);
 HexMesh exodus_read(const std::string& path);

@@ -237,7 +237,7 @@ int64_t line_of(std::string_view text, size_t pos) {
 
 }  // namespace
 
-HexMesh vtu_read(const std::string& path, std::string_view text) {
+HexMesh vtu_read(const std::string& path, std::string_view text, const FileBytes* file) {
   const std::string_view all(text);
   auto fail_at = [&](size_t pos, const std::string& message) -> void {
     throw InputError(error_at(path, line_of(all, pos), message));
@@ -411,6 +411,7 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
                           });
       else
         vtk_read_values(in, false, legacy_type, 3 * np, "point coordinate", false, store);
+      if (in_file && file) file->release(data);
       have_points = true;
     } else if (section == in_cells && section >= 0) {
       std::vector<int32_t>* out32 = name == "connectivity" ? &connectivity
@@ -432,6 +433,7 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
         reserve(data.size() / static_cast<size_t>(value_size));
         vtu_binary_values(path, data, legacy_type, static_cast<int64_t>(data.size()) / value_size,
                           what, [&](double, int64_t v) { append(v); });
+        if (in_file && file) file->release(data);
       }
       size_t read = 0;
       while (!binary && !in.at_end()) {
@@ -484,6 +486,10 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
     }
     start = end;
   }
+  // The hexes hold the cells now: the file's arrays go before the attributes are built.
+  std::vector<int32_t>().swap(connectivity);
+  std::vector<int32_t>().swap(types);
+  std::vector<int64_t>().swap(offsets);
   for (const Pending& a : cell_arrays) {
     if (a.type.empty() || !vtk_type_is_integer(a.type) || a.name.empty() ||
         mesh_find_attribute(st.mesh, a.name))
@@ -499,6 +505,7 @@ HexMesh vtu_read(const std::string& path, std::string_view text) {
             const int32_t h = st.hex_of_cell[i++];
             if (h >= 0) values[h] = static_cast<int32_t>(v);
           });
+      if (a.in_file && file) file->release(a.file_data);
       st.mesh.attributes.push_back({a.name, std::move(values)});
       continue;
     }

@@ -236,6 +236,15 @@ TEST(IoFileBytes, MapsRegularFilesAndReadsPipes) {
   const auto p = dir / "big.bin";
   io_write_text(p, big);
   EXPECT_TRUE(io_detail::FileBytes(p.string()).view() == big);
+  {
+    // Released pages of a mapping read back the same bytes (faulted in again from the file);
+    // a slice outside the mapping, or of a copied file, is left alone.
+    const io_detail::FileBytes mapped(p.string());
+    mapped.release(mapped.view().substr(1000, 200000));
+    mapped.release(mapped.view());
+    mapped.release(std::string_view(big));
+    EXPECT_TRUE(mapped.view() == big);
+  }
   const auto empty = dir / "empty.bin";
   io_write_text(empty, "");
   EXPECT_EQ(io_detail::FileBytes(empty.string()).view(), "");

@@ -166,6 +166,18 @@ struct GmshRead {
     bool integral = true;
   };
   std::vector<Data> element_data;
+  /// The mapped file (nullptr: not mapped) and its text: the bytes up to `released` are
+  /// handed back to the system as they are read (FileBytes::release).
+  const FileBytes* file = nullptr;
+  std::string_view text;
+  size_t released = 0;
+  /// Releases what the cursor has passed, in steps of 64 MB (a section can be most of a file).
+  void release_read(size_t position) {
+    constexpr size_t step = size_t{64} << 20;
+    if (file == nullptr || position < released + step) return;
+    file->release(text.substr(released, position - released));
+    released = position;
+  }
 };
 
 /// Room for `count` hexes (an upper bound the file's size was checked against), so that a large
@@ -202,6 +214,7 @@ void gmsh_element_nodes_read(GmshNumbers& in, GmshRead& g, int64_t type, int64_t
     cell[k] = static_cast<int32_t>(v);
   }
   g.mesh.hexes.push_back(cell);
+  if ((g.mesh.hexes.size() & 0xFFFF) == 0) g.release_read(in.text().position());
   g.hex_tags.push_back(tag);
   g.hex_where.push_back(where);
   g.hex_block.push_back(block);
@@ -299,6 +312,7 @@ void gmsh_nodes_read(GmshNumbers& in, const GmshFormat& f, GmshRead& g) {
         if (parametric)
           for (int64_t k = 0; k < dim; ++k) in.real("parametric coordinate");
         g.mesh.points.push_back(p);
+        if ((g.mesh.points.size() & 0xFFFF) == 0) g.release_read(in.text().position());
       }
     }
     if (static_cast<int64_t>(g.node_tags.size()) != total)
@@ -312,6 +326,7 @@ void gmsh_nodes_read(GmshNumbers& in, const GmshFormat& f, GmshRead& g) {
     for (int64_t i = 0; i < n; ++i) {
       g.node_tags.push_back(in.size_value("node tag"));
       for (int k = 0; k < 3; ++k) g.mesh.points[i][k] = in.real("node coordinate");
+      if ((i & 0xFFFF) == 0) g.release_read(in.text().position());
     }
   }
   in.text().expect("$EndNodes");
@@ -458,11 +473,13 @@ HexMesh gmsh_read(const std::string& path, std::string_view text, const FileByte
   const GmshFormat f = gmsh_format_read(cursor);
   GmshNumbers in(cursor, f.binary, f.size_bytes);
   GmshRead g;
+  g.file = file;
+  g.text = text;
   std::map<int64_t, int32_t> volume_physical;  // volume entity tag -> first physical tag
   bool have_nodes = false, have_elements = false;
   while (!cursor.at_end()) {
     // What a section held is in the mesh being built once it is read: its bytes go.
-    if (file) file->release(text.substr(0, cursor.position()));
+    g.release_read(cursor.position());
     const std::string_view section = cursor.token("a section");
     if (section == "$Entities" && f.v4) {
       gmsh_entities_read(in, volume_physical);
@@ -497,8 +514,17 @@ HexMesh gmsh_read(const std::string& path, std::string_view text, const FileByte
     throw InputError(in.message_at(
         g.hex_where[bad],
         "element tag " + std::to_string(g.hex_tags[bad]) + " repeated or not positive"));
-  // Order: by tag when the hex tags are exactly 1..m, else file order.
-  const std::vector<int32_t> slot = id_permutation_slots(g.hex_tags);
+  // Positions were kept for that message, the node index for the elements: both done with.
+  std::vector<int64_t>().swap(g.hex_where);
+  g.nodes = IdIndex();
+  // Order: by tag when the hex tags are exactly 1..m, else file order. Already in tag order
+  // (what hexrefine and gmsh write), nothing moves: no second copy of the cells.
+  std::vector<int32_t> slot = id_permutation_slots(g.hex_tags);
+  // Hex i has tag i + 1: then a field keyed by position 1, 2, ... is in hex order too.
+  bool hexes_in_tag_order = !slot.empty();
+  for (size_t i = 0; i < slot.size() && hexes_in_tag_order; ++i)
+    hexes_in_tag_order = slot[i] == static_cast<int32_t>(i);
+  if (hexes_in_tag_order) std::vector<int32_t>().swap(slot);
   if (!slot.empty()) {
     std::vector<HexCell> cells(m);
     std::vector<int32_t> blocks(m);
@@ -512,10 +538,15 @@ HexMesh gmsh_read(const std::string& path, std::string_view text, const FileByte
   auto slot_of = [&](size_t i) { return slot.empty() ? static_cast<int32_t>(i) : slot[i]; };
   g.mesh.attributes.push_back({std::string(attribute_block_id), std::move(g.hex_block)});
   for (GmshRead::Data& d : g.element_data) {
-    std::vector<int32_t> values(m, 0);
-    for (size_t k = 0; k < d.values.size(); ++k) {
-      const int64_t i = hexes.find(d.tags.empty() ? static_cast<int64_t>(k) + 1 : d.tags[k]);
-      if (i >= 0) values[slot_of(static_cast<size_t>(i))] = d.values[k];  // else: a skipped element
+    std::vector<int32_t> values;
+    if (d.tags.empty() && slot.empty() && d.values.size() == m && hexes_in_tag_order) {
+      values = std::move(d.values);  // one value per hex, in hex order already
+    } else {
+      values.assign(m, 0);
+      for (size_t k = 0; k < d.values.size(); ++k) {
+        const int64_t i = hexes.find(d.tags.empty() ? static_cast<int64_t>(k) + 1 : d.tags[k]);
+        if (i >= 0) values[slot_of(static_cast<size_t>(i))] = d.values[k];  // else: skipped
+      }
     }
     d.values = {};
     d.tags = {};
@@ -527,6 +558,10 @@ HexMesh gmsh_read(const std::string& path, std::string_view text, const FileByte
     }
     g.mesh.attributes.push_back({d.name, std::move(values)});
   }
+  // The tags and their index are done with: they go before the manifold test builds its face
+  // slots (peak memory).
+  std::vector<int64_t>().swap(g.hex_tags);
+  hexes = IdIndex();
   mesh_check_read(g.mesh, path);
   return std::move(g.mesh);
 }

@@ -45,6 +45,33 @@ TEST(IoGmsh, Reads22WithPhysicalTagsAndSkipsQuads) {
   EXPECT_EQ(*mesh_find_attribute(m, attribute_block_id), std::vector<int32_t>{9});
 }
 
+TEST(IoGmsh, HexesOutOfTagOrderAndTheirDataAreReorderedTogether) {
+  // Two hexes listed as tags 2, 1 (read in tag order), a field for tags 1, 2 and one for tag 2
+  // only; then the same hexes in tag order, where the full field is taken over as it is.
+  const auto dir = test_temp_dir("io_gmsh_order");
+  std::string nodes;
+  for (int i = 0; i < 12; ++i)
+    nodes += std::to_string(i + 1) + " " + std::to_string(i & 1) + " " +
+             std::to_string((i >> 1) & 1) + " " + std::to_string(i >> 2) + "\n";
+  const std::string hex1 = "5 2 1 1 1 2 4 3 5 6 8 7\n", hex2 = "5 2 1 1 5 6 8 7 9 10 12 11\n";
+  const std::string data =
+      "$ElementData\n1\n\"level\"\n1\n0.0\n3\n0\n1\n2\n1 10\n2 20\n$EndElementData\n"
+      "$ElementData\n1\n\"tag\"\n1\n0.0\n3\n0\n1\n1\n2 7\n$EndElementData\n";
+  for (const bool swapped : {true, false}) {
+    const auto p = dir / (swapped ? "swapped.msh" : "ordered.msh");
+    io_write_text(p, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n12\n" + nodes +
+                         "$EndNodes\n$Elements\n2\n" +
+                         (swapped ? "2 " + hex2 + "1 " + hex1 : "1 " + hex1 + "2 " + hex2) +
+                         "$EndElements\n" + data);
+    const HexMesh m = mesh_read(p.string());
+    ASSERT_EQ(m.hex_count(), 2) << swapped;
+    EXPECT_EQ(m.hexes[0], (HexCell{0, 1, 3, 2, 4, 5, 7, 6})) << swapped;
+    EXPECT_EQ(m.hexes[1], (HexCell{4, 5, 7, 6, 8, 9, 11, 10})) << swapped;
+    EXPECT_EQ(*mesh_find_attribute(m, "level"), (std::vector<int32_t>{10, 20})) << swapped;
+    EXPECT_EQ(*mesh_find_attribute(m, "tag"), (std::vector<int32_t>{0, 7})) << swapped;
+  }
+}
+
 TEST(IoGmsh, RefusesTetsUndefinedNodesAndOtherVersions) {
   const auto dir = test_temp_dir("io_gmsh_bad");
   const std::string head =

@@ -64,14 +64,6 @@ bool template_is_boxes(const HexTemplate& t) {
   return true;
 }
 
-/// Unit normal of a patch from its diagonals; zero for a degenerate patch.
-Eigen::Vector3d quad_unit_normal(const Quad& q) {
-  const Eigen::Vector3d cross = (q[2] - q[0]).cross(q[3] - q[1]);
-  const double size2 = std::max((q[2] - q[0]).squaredNorm(), (q[3] - q[1]).squaredNorm());
-  return cross.norm() > 1e-12 * size2 ? Eigen::Vector3d(cross.normalized())
-                                      : Eigen::Vector3d::Zero();
-}
-
 /// The template node behind a new node: the use, and the plan node of its first active child.
 struct NodeOrigin {
   int32_t use = -1;

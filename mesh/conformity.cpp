@@ -152,13 +152,6 @@ BoundarySurface boundary_surface(const HexMesh& mesh, std::vector<HexFaceSlot> s
   return s;
 }
 
-/// Unit normal of a quad from its diagonals (zero if degenerate).
-Eigen::Vector3d quad_diagonal_normal(const Quad& q) {
-  const Eigen::Vector3d n = (q[2] - q[0]).cross(q[3] - q[1]);
-  const double size2 = std::max((q[2] - q[0]).squaredNorm(), (q[3] - q[1]).squaredNorm());
-  return n.norm() > 1e-12 * size2 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
-}
-
 /// A boundary face across reference faces (see conformity.hpp): each corner on a reference face
 /// whose normal is within mesh_check_across_angle_degrees of the face's, the centroid within
 /// mesh_check_across_chord x the face's diameter of a reference face near it. Conservative: a
@@ -166,12 +159,12 @@ Eigen::Vector3d quad_diagonal_normal(const Quad& q) {
 /// reported non-conformal, never the reverse).
 bool face_lies_across_reference(const Quad& q, const QuadGrid& grid,
                                 const BoundarySurface& reference) {
-  const Eigen::Vector3d normal = quad_diagonal_normal(q);
+  const Eigen::Vector3d normal = quad_unit_normal(q);
   if (normal.isZero()) return false;
   const double cos_limit = std::cos(mesh_check_across_angle_degrees * std::numbers::pi / 180);
   for (int k = 0; k < 4; ++k) {
     const bool found = grid.find(q[k], [&](int32_t j) {
-      return std::abs(quad_diagonal_normal(reference.quads[j]).dot(normal)) >= cos_limit;
+      return std::abs(quad_unit_normal(reference.quads[j]).dot(normal)) >= cos_limit;
     });
     if (!found) return false;
   }

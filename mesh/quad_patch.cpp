@@ -29,6 +29,13 @@ double quad_area(const Quad& q) {
   return area;
 }
 
+Eigen::Vector3d quad_unit_normal(const Quad& q) {
+  const Eigen::Vector3d cross = (q[2] - q[0]).cross(q[3] - q[1]);
+  const double size2 = std::max((q[2] - q[0]).squaredNorm(), (q[3] - q[1]).squaredNorm());
+  return cross.norm() > 1e-12 * size2 ? Eigen::Vector3d(cross.normalized())
+                                      : Eigen::Vector3d::Zero();
+}
+
 double quad_warp(const Quad& q) {
   const Eigen::Vector3d n = (q[2] - q[0]).cross(q[3] - q[1]);
   const double n_norm = n.norm();

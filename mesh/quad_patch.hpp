@@ -22,6 +22,11 @@ std::array<Eigen::Vector3d, 2> quad_tangents(const Quad& q, double u, double v);
 /// The longer diagonal.
 double quad_diameter(const Quad& q);
 
+/// Unit normal of the quad's diagonals, (q2 - q0) x (q3 - q1) normalized (the patch normal at
+/// its centre); zero when |(q2 - q0) x (q3 - q1)| <= 1e-12 x the longer diagonal squared (a
+/// degenerate quad). Unit square q0..q3 = (0,0,0), (1,0,0), (1,1,0), (0,1,0): +z.
+Eigen::Vector3d quad_unit_normal(const Quad& q);
+
 /// Area of the patch: the integral of |S_u x S_v| by 3x3 Gauss points (exact for planar quads,
 /// where the integrand is linear; an approximation for warped ones). Unit square: 1.
 double quad_area(const Quad& q);

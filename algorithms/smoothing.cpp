@@ -118,18 +118,15 @@ SmoothNodeClasses mesh_classify_smooth_nodes(const HexMesh& mesh, const HexTopol
   std::vector<EdgeFaces> edge_faces;
   for (int32_t f : topology_boundary_faces(topology)) {
     const auto& q = topology.face_nodes[f];
-    const Vec3 cross =
-        (mesh.points[q[2]] - mesh.points[q[0]]).cross(mesh.points[q[3]] - mesh.points[q[1]]);
-    const double size2 = std::max((mesh.points[q[2]] - mesh.points[q[0]]).squaredNorm(),
-                                  (mesh.points[q[3]] - mesh.points[q[1]]).squaredNorm());
-    const bool degenerate = !(cross.norm() > 1e-12 * size2);
+    const Vec3 normal = quad_unit_normal(
+        {mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
+    const bool degenerate = normal.isZero();
     for (int k = 0; k < 4; ++k) {
       const int32_t n = q[k];
       if (c.kind[n] == SmoothNodeKind::interior) c.kind[n] = SmoothNodeKind::surface;
       if (degenerate) corner[n] = 1;
       const uint32_t a = static_cast<uint32_t>(q[k]), b = static_cast<uint32_t>(q[(k + 1) % 4]);
-      edge_faces.push_back({static_cast<uint64_t>(std::min(a, b)) << 32 | std::max(a, b),
-                            degenerate ? Vec3::Zero() : Vec3(cross.normalized())});
+      edge_faces.push_back({static_cast<uint64_t>(std::min(a, b)) << 32 | std::max(a, b), normal});
     }
   }
   std::sort(edge_faces.begin(), edge_faces.end(),

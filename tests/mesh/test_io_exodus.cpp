@@ -22,6 +22,38 @@ TEST(IoExodus, RoundTripIsExactAndKeepsBlocksAndOrder) {
   EXPECT_EQ(r.attributes.size(), m.attributes.size());
 }
 
+// The writer reserves free header space before the library defines anything, so that no later
+// definition moves the variables already placed (netCDF-3 moves every variable, written or not,
+// whenever the header outgrows its space). The layout shows it: the first variable, the one-byte
+// reserve, begins after at least 64 KiB of header. Read from the raw CDF-2 header entry of that
+// variable: name, no dimensions, no attributes, type, size, then its 8-byte big-endian offset.
+TEST(IoExodus, HeaderSpaceIsReservedSoDefinitionsMoveNoData) {
+  const auto dir = test_temp_dir("io_exodus_header_space");
+  const std::string path = (dir / "brick.e").string();
+  mesh_write(path, io_test_brick());
+  const std::string bytes = test_file_text(path);
+  ASSERT_EQ(bytes.substr(0, 4), std::string("CDF\x02", 4));  // 64-bit offsets
+  const std::string name = "hexrefine_header_reserve";
+  const size_t at = bytes.find(name);
+  ASSERT_NE(at, std::string::npos);
+  size_t p = at + (name.size() + 3) / 4 * 4;  // the name, padded to 4 bytes
+  auto be = [&](size_t width) {
+    uint64_t v = 0;
+    for (size_t k = 0; k < width; ++k) v = v << 8 | static_cast<unsigned char>(bytes.at(p + k));
+    p += width;
+    return v;
+  };
+  EXPECT_EQ(be(4), 0u);  // no dimensions: a scalar
+  EXPECT_EQ(be(4), 0u);  // ABSENT attribute list
+  EXPECT_EQ(be(4), 0u);
+  EXPECT_EQ(be(4), 2u);  // NC_CHAR
+  be(4);                 // its padded size
+  const uint64_t begin = be(8);
+  EXPECT_GE(begin, 65536u);
+  EXPECT_LT(begin, bytes.size());
+  EXPECT_EQ(mesh_read(path).hex_count(), io_test_brick().hex_count());
+}
+
 TEST(IoExodus, ParentHexIsAnElementVariableAndFloatFieldsAreNotAttributes) {
   const auto dir = test_temp_dir("io_exodus_variables");
   HexMesh m = io_test_brick();

@@ -14,6 +14,7 @@
 
 #include "algorithms/pipeline.hpp"
 #include "experiments/cli.hpp"
+#include "experiments/process_huge_pages.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/conformity.hpp"
 #include "mesh/dual.hpp"
@@ -82,6 +83,7 @@ int check_run(const CliArgs& a) {
   }
   json["stage_seconds"] = stage_seconds;
   json["peak_memory_mb"] = process_peak_memory_mb();
+  json["huge_pages"] = process_uses_huge_pages();
 
   std::ostream& out = std::cout;
   out << path << ": " << report.hexes << " hexes, " << report.nodes << " nodes, "

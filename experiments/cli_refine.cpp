@@ -25,6 +25,7 @@
 #include "algorithms/pipeline.hpp"
 #include "experiments/cli.hpp"
 #include "experiments/cli_output.hpp"
+#include "experiments/process_huge_pages.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
 
@@ -100,6 +101,7 @@ int refine_run(const CliArgs& a) {
     nlohmann::json report = pipeline_report(r, o);
     report["input"] = in;
     report["output"] = out;
+    report["huge_pages"] = process_uses_huge_pages();
     file_write_atomically(*report_path, [&](std::ostream& os) { os << report.dump(2) << "\n"; });
   }
   const MeshCheckReport& final_check = r.smoothed_check ? *r.smoothed_check : r.check;

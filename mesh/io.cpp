@@ -188,8 +188,14 @@ std::vector<int32_t> id_permutation_slots(const std::vector<int64_t>& ids) {
   return slot;
 }
 
-void mesh_check_read(const HexMesh& mesh, const std::string& path) {
+void mesh_check_read(const HexMesh& mesh, const std::string& path, bool manifold_test) {
   mesh_validate_ids(mesh, path);
+  if (manifold_test) mesh_require_manifold(mesh, path);
+}
+
+}  // namespace io_detail
+
+void mesh_require_manifold(const HexMesh& mesh, const std::string& path) {
   // Only the non-manifold faces are wanted: no neighbour array (a third of the peak memory of
   // reading an 11 M-hex mesh).
   const HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, 1, false);
@@ -203,8 +209,6 @@ void mesh_check_read(const HexMesh& mesh, const std::string& path) {
                      std::to_string(adjacency.nonmanifold_faces.size()) + " such faces)");
   }
 }
-
-}  // namespace io_detail
 
 namespace {
 
@@ -244,11 +248,9 @@ MeshFormat mesh_format_of(const std::string& path) {
                    "or .inp)");
 }
 
-HexMesh mesh_read(const std::string& path) {
-  const MeshFormat format = mesh_format_of(path);
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw InputError(path + ": is a folder, expected a mesh file");
+namespace {
+
+HexMesh mesh_read_format(const std::string& path, MeshFormat format) {
   switch (format) {
     case MeshFormat::medit:
       return io_detail::medit_read(path, io_detail::FileBytes(path).view());
@@ -270,6 +272,19 @@ HexMesh mesh_read(const std::string& path) {
   throw InputError(path + ": unknown mesh format");
 }
 
+}  // namespace
+
+HexMesh mesh_read(const std::string& path, const MeshReadOptions& options) {
+  const MeshFormat format = mesh_format_of(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path + ": is a folder, expected a mesh file");
+  // The checks run once the reader has returned and freed what it held (peak memory).
+  HexMesh mesh = mesh_read_format(path, format);
+  io_detail::mesh_check_read(mesh, path, options.manifold_test);
+  return mesh;
+}
+
 HexMesh mesh_read_from_memory(const std::string& name, std::string_view bytes) {
   const MeshFormat format = mesh_format_of(name);
   if (format == MeshFormat::exodus) {
@@ -289,7 +304,9 @@ HexMesh mesh_read_from_memory(const std::string& name, std::string_view bytes) {
       if (!out) throw OperationError(name + ": cannot write a temporary file to read Exodus II");
     }
     try {
-      return io_detail::exodus_read(tmp);
+      HexMesh mesh = io_detail::exodus_read(tmp);
+      io_detail::mesh_check_read(mesh, tmp, true);
+      return mesh;
     } catch (const InputError& e) {
       // Name the caller's source, not the temporary file.
       std::string message = e.what();
@@ -298,21 +315,28 @@ HexMesh mesh_read_from_memory(const std::string& name, std::string_view bytes) {
     }
   }
   const std::string_view text = bytes;
+  HexMesh mesh;
   switch (format) {
     case MeshFormat::medit:
-      return io_detail::medit_read(name, text);
-    case MeshFormat::vtk_legacy:
-      return io_detail::vtk_read(name, text);
-    case MeshFormat::vtu:
-      return io_detail::vtu_read(name, text);
-    case MeshFormat::gmsh:
-      return io_detail::gmsh_read(name, text);
-    case MeshFormat::abaqus:
-      return io_detail::abaqus_read(name, text);
-    case MeshFormat::exodus:
+      mesh = io_detail::medit_read(name, text);
       break;
+    case MeshFormat::vtk_legacy:
+      mesh = io_detail::vtk_read(name, text);
+      break;
+    case MeshFormat::vtu:
+      mesh = io_detail::vtu_read(name, text);
+      break;
+    case MeshFormat::gmsh:
+      mesh = io_detail::gmsh_read(name, text);
+      break;
+    case MeshFormat::abaqus:
+      mesh = io_detail::abaqus_read(name, text);
+      break;
+    case MeshFormat::exodus:
+      throw InputError(name + ": unknown mesh format");
   }
-  throw InputError(name + ": unknown mesh format");
+  io_detail::mesh_check_read(mesh, name, true);
+  return mesh;
 }
 
 void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOptions& options) {

@@ -65,9 +65,21 @@ struct MeshWriteOptions {
   std::vector<std::pair<std::string, std::vector<double>>> cell_scalars;
 };
 
+struct MeshReadOptions {
+  /// Refuse a mesh with a face shared by more than two hexes (mesh_require_manifold). Only a
+  /// caller that matches the faces itself right after reading, and refuses the same way, turns it
+  /// off: `hexrefine check`, whose checker counts non-manifold faces (matching the faces of an
+  /// 11.4 M-hex mesh twice cost a second).
+  bool manifold_test = true;
+};
+
 /// Reads a hex mesh; the format follows from the extension. Throws InputError
-/// "path:line: what was expected" on bad input.
-HexMesh mesh_read(const std::string& path);
+/// "path:line: what was expected" on bad input, and for ids out of range or repeated in a hex.
+HexMesh mesh_read(const std::string& path, const MeshReadOptions& options = {});
+
+/// Throws InputError "path: non-manifold mesh: face with nodes a b c d (0-based) is shared by
+/// more than two hexes (N such faces)" when a face is. Precondition: mesh_validate_ids holds.
+void mesh_require_manifold(const HexMesh& mesh, const std::string& path);
 
 /// Reads a hex mesh from the bytes of a file held in memory (fuzzing, tests, data received by
 /// other means). `name` gives the format by its extension (as mesh_read) and names the source in

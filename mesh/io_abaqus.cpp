@@ -250,7 +250,6 @@ HexMesh abaqus_read(const std::string& path, std::string_view text) {
       element_block[e] = s.block;
     }
   mesh.attributes.push_back({std::string(attribute_block_id), std::move(element_block)});
-  mesh_check_read(mesh, path);
   return mesh;
 }
 

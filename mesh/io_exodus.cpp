@@ -328,7 +328,6 @@ HexMesh exodus_read(const std::string& path) {
       a.values = std::move(ordered);
     }
   }
-  mesh_check_read(mesh, path);
   return mesh;
 }
 

@@ -297,9 +297,9 @@ bool items_sort_by_permutation_ids(std::vector<T>& items, std::vector<int64_t>& 
   return true;
 }
 
-/// The checks every reader ends with: ids in range and distinct per hex (mesh_validate_ids), no
-/// face shared by more than two hexes (message names the face's nodes, 0-based).
-void mesh_check_read(const HexMesh& mesh, const std::string& path);
+/// The checks every read ends with (mesh_read runs them on what the reader returns): ids in range
+/// and distinct per hex (mesh_validate_ids), then, with `manifold_test`, mesh_require_manifold.
+void mesh_check_read(const HexMesh& mesh, const std::string& path, bool manifold_test);
 
 /// Hexes grouped by block_id, for the writers that store one block per id (Exodus element
 /// blocks, Gmsh volume entities, Abaqus element sets): `ids` ascending and distinct; the hexes of

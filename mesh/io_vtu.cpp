@@ -515,7 +515,6 @@ HexMesh vtu_read(const std::string& path, std::string_view text, const FileBytes
     vtk_read_array(in, false, st, true, a.name, a.type, 1, nc);
     if (!in.at_end()) in.fail("more than NumberOfCells values in DataArray '" + a.name + "'");
   }
-  mesh_check_read(st.mesh, path);
   return std::move(st.mesh);
 }
 

@@ -161,6 +161,7 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
   }
   clock.end("refine");
   clock.begin("check");
+  std::vector<uint8_t> is_child;  // per output hex: made by refining an input hex
   {
     // A refined parent's children are a level above it (the input's own levels, if any, kept).
     const std::vector<int32_t>* parent = mesh_find_attribute(r.mesh, attribute_parent_hex);
@@ -178,6 +179,11 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
         r.refined_parents_min_scaled_jacobian = std::min(r.refined_parents_min_scaled_jacobian,
                                                          hex_scaled_jacobian(hex_points(input, h)));
       }
+    is_child.resize(r.mesh.hexes.size(), 0);
+    for (int32_t h = 0; parent && level && h < r.mesh.hex_count(); ++h)
+      if ((is_child[h] = refined[(*parent)[h]]))
+        r.children_min_scaled_jacobian =
+            std::min(r.children_min_scaled_jacobian, hex_scaled_jacobian(hex_points(r.mesh, h)));
   }
 
   r.check = mesh_check(r.mesh, &input, o.refine.threads);
@@ -199,6 +205,10 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
       clock.end("smooth");
       clock.begin("check (smoothed)");
       r.smoothed_check = mesh_check(r.mesh, &input, o.refine.threads);
+      double children = 1;
+      for (int32_t h = 0; h < r.mesh.hex_count(); ++h)
+        if (is_child[h]) children = std::min(children, hex_scaled_jacobian(hex_points(r.mesh, h)));
+      r.smoothed_children_min_scaled_jacobian = children;
       clock.end("check_smoothed");
       verdict_enforce(*r.smoothed_check, r.mesh, input, o, r.ablation, "smoothing");
     }
@@ -249,7 +259,11 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
   j["selection"] = selection;
   j["refine"] = r.stats;
   j["refined_parents"] = {{"hexes", r.refined_parents},
-                          {"min_scaled_jacobian", r.refined_parents_min_scaled_jacobian}};
+                          {"min_scaled_jacobian", r.refined_parents_min_scaled_jacobian},
+                          {"children_min_scaled_jacobian", r.children_min_scaled_jacobian}};
+  if (r.smoothed_children_min_scaled_jacobian)
+    j["refined_parents"]["smoothed_children_min_scaled_jacobian"] =
+        *r.smoothed_children_min_scaled_jacobian;
   j["check"] = r.check;
   if (r.smoothing) j["smoothing"] = {{"stats", *r.smoothing}, {"check", *r.smoothed_check}};
   j["stage_seconds"] = r.stage_seconds;

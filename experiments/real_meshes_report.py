@@ -15,7 +15,6 @@ Exit status 2 on bad input.
 
 import argparse
 import os
-import sys
 
 import matplotlib
 
@@ -60,11 +59,17 @@ def summarise(r):
     s["min"] = check["min_scaled_jacobian"]
     s["valid"] = check["valid"]
     s["hexes"] = check["hexes"]
+    s["input_hexes"] = r["input"]["hexes"]
     s["below"] = share_below(check["scaled_jacobian_histogram"])
     s["histogram"] = check["scaled_jacobian_histogram"]
     smoothing = r.get("smoothing")
     s["smoothed"] = smoothing["check"]["min_scaled_jacobian"] if smoothing else s["min"]
     s["smoothed_valid"] = smoothing["check"]["valid"] if smoothing else s["valid"]
+    # The children of the refined parents alone: the mesh-wide minimum also holds untouched input
+    # hexes, which can be worse than every refined parent.
+    parents = r["refined_parents"]
+    s["children"] = parents.get("children_min_scaled_jacobian", s["min"])
+    s["children_smoothed"] = parents.get("smoothed_children_min_scaled_jacobian", s["children"])
     stages = r["stage_seconds"]
     s["refine_s"] = stages.get("refine", 0.0)
     s["placement_s"] = r["refine"]["placement"]["seconds"]
@@ -132,8 +137,15 @@ def main():
     optimized = [s for s in rows if not s["error"] and s["placement"] == "optimized"]
     ratio_ok = [s for s in optimized if s["min"] >= 0.3 * s["parents"] - 1e-12]
     smooth_ok = [s for s in optimized if s["smoothed"] >= 0.5 * s["parents"] - 1e-12]
+    children_ok = [s for s in optimized if s["children"] >= 0.3 * s["parents"] - 1e-12]
+    children_smooth_ok = [s for s in optimized
+                          if s["children_smoothed"] >= 0.5 * s["parents"] - 1e-12]
     smooth_never_lower = [s for s in rows if not s["error"] and s["smoothed"] >= s["min"] - 1e-12]
     fast = [s for s in optimized if s["smooth_s"] <= 5 * s["refine_s"]]
+    # The issue's time target is for rockerarm-sized cases (10,600 input hexes): on the small
+    # meshes both phases take milliseconds and their ratio says little.
+    sized = [s for s in optimized if s["input_hexes"] >= 5000]
+    sized_fast = [s for s in sized if s["smooth_s"] <= 5 * s["refine_s"]]
     issue = [s for s in optimized if s["kind"] == "issue-sphere" and s["method"] == "selective"]
     done = [s for s in rows if not s["error"]]
     out.append("\n## Targets\n")
@@ -151,14 +163,20 @@ def main():
                        ("; ..." if len(bad) > 6 else "") + ")"))
     out.append("| optimized, unsmoothed: output min >= 0.3 x parents' min | %d of %d |" % (
         len(ratio_ok), len(optimized)))
+    out.append("| the same over the children alone (untouched input hexes left out) | %d of %d |" % (
+        len(children_ok), len(optimized)))
     out.append("| rockerarm `sphere:0,0,0,5` (selective, optimized) >= 0.16 | %s |" % (
         ", ".join(fmt(s["min"], 4) for s in issue) or "–"))
     out.append("| `--smooth`: >= 0.5 x parents' min (optimized) | %d of %d |" % (
         len(smooth_ok), len(optimized)))
+    out.append("| the same over the children alone (untouched input hexes left out) | %d of %d |" % (
+        len(children_smooth_ok), len(optimized)))
     out.append("| `--smooth` never below the unsmoothed mesh | %d of %d |" % (
         len(smooth_never_lower), len(done)))
     out.append("| `--smooth` at most 5x the refinement time (optimized) | %d of %d |" % (
         len(fast), len(optimized)))
+    out.append("| the same on the rockerarm-sized inputs (5,000 hexes or more) | %d of %d |" % (
+        len(sized_fast), len(sized)))
     out.append("| every output written valid (checked against its input) | %d of %d |" % (
         sum(1 for s in done if s["valid"] and s["smoothed_valid"]), len(done)))
 
@@ -185,19 +203,23 @@ def main():
         out.append(anisotropy_section(anisotropy))
 
     out.append("\n## Every case\n")
+    out.append("*children*: the minimum over the hexes made by refining the parents, unsmoothed "
+               "and smoothed; *output* and *smoothed*: over the whole mesh.\n")
     out.append("| mesh | region | method | placement | output hexes | parents min | output min "
-               "| smoothed min | below 0.2 | refine s | of it placement s | smooth s |")
-    out.append("|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+               "| children min | smoothed min | children smoothed | below 0.2 | refine s "
+               "| of it placement s | smooth s |")
+    out.append("|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for s in rows:
         if s["error"]:
-            out.append("| %s | %s | %s | %s | refused: %s | | | | | | | |" % (
+            out.append("| %s | %s | %s | %s | refused: %s | | | | | | | | | |" % (
                 s["mesh"], s["kind"], s["method"], s["placement"],
                 s["error"].replace("|", "/").replace("\n", " ")[:140]))
             continue
-        out.append("| %s | %s | %s | %s | %s | %s | %s%s | %s | %s | %s | %s | %s |" % (
+        out.append("| %s | %s | %s | %s | %s | %s | %s%s | %s | %s | %s | %s | %s | %s | %s |" % (
             s["mesh"], s["kind"], s["method"], s["placement"], fmt(s["hexes"]),
             fmt(s["parents"], 4), fmt(s["min"], 4), "" if s["valid"] else " INVALID",
-            fmt(s["smoothed"], 4), "%.1f%%" % (100 * s["below"]), fmt(s["refine_s"]),
+            fmt(s["children"], 4), fmt(s["smoothed"], 4), fmt(s["children_smoothed"], 4),
+            "%.1f%%" % (100 * s["below"]), fmt(s["refine_s"]),
             fmt(s["placement_s"]), fmt(s["smooth_s"])))
     path = os.path.join(args.out, "real_meshes.md")
     with open(path + ".tmp", "w", encoding="utf-8") as f:

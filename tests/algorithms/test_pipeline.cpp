@@ -1,0 +1,44 @@
+#include "algorithms/pipeline.hpp"
+
+#include <gtest/gtest.h>
+
+#include "mesh/generators.hpp"
+#include "mesh/quality.hpp"
+
+namespace hexrefine {
+namespace {
+
+// One target in the middle of a 5x5x5 brick of unit cubes, whose corner hex (far from the
+// refined region) is distorted below the 1-13 template's 0.3077: the mesh-wide minimum is that
+// untouched hex, the children's minimum the template's own value, for both refiners.
+TEST(Pipeline, ChildrenMinimumLeavesOutUntouchedInputHexes) {
+  const std::array<int, 3> dims{5, 5, 5};
+  HexMesh m = generate_brick({.dims = dims, .size = {5, 5, 5}});
+  m.points[brick_node(dims, 0, 0, 0)] = Eigen::Vector3d(-1.5, -1.5, -1.5);
+  const double corner = hex_scaled_jacobian(hex_points(m, brick_hex(dims, 0, 0, 0)));
+  ASSERT_GT(corner, 0.0);
+  ASSERT_LT(corner, 0.25);
+  for (const char* method : {"selective", "sheet"}) {
+    SCOPED_TRACE(method);
+    PipelineOptions o;
+    o.method = method;
+    o.targets = std::vector<int32_t>{brick_hex(dims, 2, 2, 2)};
+    o.refine.placement.method = PlacementMethod::trilinear;
+    o.smooth = true;
+    const PipelineResult r = pipeline_run(m, o);
+    EXPECT_EQ(r.refined_parents, 19);  // the target, its 6 face and 12 edge neighbours
+    EXPECT_DOUBLE_EQ(r.refined_parents_min_scaled_jacobian, 1.0);
+    EXPECT_DOUBLE_EQ(r.check.min_scaled_jacobian, corner);
+    EXPECT_NEAR(r.children_min_scaled_jacobian, 0.3077, 5e-5);
+    ASSERT_TRUE(r.smoothed_children_min_scaled_jacobian);
+    EXPECT_GT(*r.smoothed_children_min_scaled_jacobian, 0.4);  // smoothing lifts the children
+    const nlohmann::json j = pipeline_report(r, o);
+    EXPECT_DOUBLE_EQ(j["refined_parents"]["children_min_scaled_jacobian"].get<double>(),
+                     r.children_min_scaled_jacobian);
+    EXPECT_DOUBLE_EQ(j["refined_parents"]["smoothed_children_min_scaled_jacobian"].get<double>(),
+                     *r.smoothed_children_min_scaled_jacobian);
+  }
+}
+
+}  // namespace
+}  // namespace hexrefine

@@ -10,7 +10,9 @@
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 bin=$repo/build/experiments/hexrefine
-out=$repo/results/performance/command.json
+# OUT: another output file, e.g. for a run with HEXREFINE_HUGE_PAGES=0 (4 KiB pages), which
+# report.py compares with command.json.
+out=${OUT:-$repo/results/performance/command.json}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$bin" generate brick "$tmp/b75.e" --dims 75,75,75 > /dev/null
@@ -57,6 +59,7 @@ floor=$(awk "BEGIN { print ($end - $start) / 1e9 }")
   echo "{"
   echo "  \"date\": \"$(date -u +%Y-%m-%dT%H:%M:%SZ)\", \"commit\": \"$(git -C "$repo" rev-parse HEAD)\","
   echo "  \"cpus\": $(nproc), \"load_average\": \"$(cut -d' ' -f1-3 /proc/loadavg)\","
+  echo "  \"huge_pages_opt_out\": \"${HEXREFINE_HUGE_PAGES:-}\","
   echo "  \"output_bytes\": {\"e\": $size_e, \"vtu\": $size_vtu, \"msh\": $size_msh},"
   echo "  \"page_cache_write_floor_s\": $floor,"
   echo "  \"runs\": ["

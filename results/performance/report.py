@@ -253,6 +253,29 @@ def command_section():
           f"{ratio:.1f}x as long in this run: the machine's speed differs between sessions, so compare "
           "rows within one run, not across runs.")
         w("")
+    small_pages_path = os.path.join(here, "command_no_huge_pages.json")
+    if os.path.exists(small_pages_path):
+        q = load("command_no_huge_pages.json")
+        qruns = {r["name"]: r for r in q["runs"]}
+        w(f"Huge pages: the same commands with `HEXREFINE_HUGE_PAGES=0` (4 KiB pages; "
+          f"`command_no_huge_pages.json`, {q['date']}, right after the run above). The command "
+          "re-executes itself with glibc's `glibc.malloc.hugetlb=1` where the kernel gives "
+          "transparent huge pages on request (`experiments/process_huge_pages.hpp`); each "
+          "report records whether it ran with them.")
+        w("")
+        w("| command | threads | wall s, huge pages | wall s, 4 KiB pages | refine stage, huge | refine stage, 4 KiB |")
+        w("|---|---:|---:|---:|---:|---:|")
+        for name, r in runs.items():
+            other = qruns.get(name)
+            if not other:
+                continue
+            kind, ext, _, threads = name.split("_")
+            huge = (r.get("report") or {}).get("stage_seconds", {}).get("refine")
+            small = (other.get("report") or {}).get("stage_seconds", {}).get("refine")
+            w(f"| {kind} {'to ' if kind == 'refine' else ''}.{ext} | {threads} | {r['wall_s']:.2f} | "
+              f"{other['wall_s']:.2f} | {'' if huge is None else f'{huge:.2f}'} | "
+              f"{'' if small is None else f'{small:.2f}'} |")
+        w("")
     size_e, size_vtu = c["output_bytes"]["e"], c["output_bytes"]["vtu"]
     raw = 11390625 * (8 * 4 + 4 + 1) + 11543176 * 24  # Int32 connectivity, offsets, types; Float64 points
     attributes = 11390625 * 4 * 4  # block_id, template_tag, refinement_level, parent_hex (Int32)
@@ -274,8 +297,13 @@ def command_section():
     w("topology (and counts the dual sheets only with `--sheets`), finds duplicate nodes by a")
     w("counting sort into cells, shares edge vectors between quality samples and runs on both")
     w("cores with `--threads`; readers reject non-manifold input the same way; Exodus II is")
-    w("written definitions-first (no header growth moving written data) and read and written in")
-    w("1 M-entry chunks instead of whole-mesh copies. Since 2026-11-25 the other readers map the")
+    w("written definitions-first and read and written in 1 M-entry chunks instead of whole-mesh")
+    w("copies. (Definitions-first did not stop the data moves: netCDF-3 moves every variable")
+    w("already defined, written or not, whenever a definition outgrows the header, and the")
+    w("library's own definitions did so about six times, each a read and rewrite in 8 KB blocks;")
+    w("since 17:20 on 2026-11-25 the writer reserves header space first and writes the file's")
+    w("bytes once: tests/mesh/test_io_exodus.cpp reads the layout.) Since 2026-11-25 the other")
+    w("readers map the")
     w("file (mmap) instead of copying it into a zero-filled buffer, and the Gmsh reader resolves")
     w("hex nodes as it reads them and keeps $ElementData as Int32: the binary .msh check went from")
     w("34 s read and 4.9 GB (first version, run at 12:00 the same day) to 14.4 s and 3.6 GB;")
@@ -293,7 +321,8 @@ def command_section():
     w("within a section, stopped copying hexes already in tag order, took over a field keyed")
     w("1..m as it is and freed positions and indexes once used: check .msh 1.81 -> 1.39 GB. All")
     w("three checks now peak in the check stage (the face matching beside the mesh); the figures")
-    w("above.")
+    w("above. Then (17:30) `hexrefine check` stopped matching the faces twice (the reader's")
+    w("manifold test and the checker's own), and (17:25) the command runs with huge pages.")
     w("`hexrefine check --verbose` and `refine --verbose` print the peak after each stage.")
     w("")
 

@@ -112,9 +112,15 @@ void node_problem_connect(NodeProblem& problem, const HexMesh& mesh,
   for (int32_t i = 0; i < n; ++i) problem.node_hex_offsets[i + 1] += problem.node_hex_offsets[i];
   problem.node_hex.resize(problem.node_hex_offsets[n]);
   std::vector<int32_t> cursor(problem.node_hex_offsets.begin(), problem.node_hex_offsets.end() - 1);
-  for (size_t k = 0; k < problem.hexes.size(); ++k)
-    for (int32_t v : mesh.hexes[problem.hexes[k]])
-      if (local[v] >= 0) problem.node_hex[cursor[local[v]]++] = static_cast<int32_t>(k);
+  problem.hex_local_nodes.resize(problem.hexes.size());
+  for (size_t k = 0; k < problem.hexes.size(); ++k) {
+    const HexCell& c = mesh.hexes[problem.hexes[k]];
+    for (int corner = 0; corner < 8; ++corner) {
+      const int32_t j = local[c[corner]];
+      problem.hex_local_nodes[k][corner] = j;
+      if (j >= 0) problem.node_hex[cursor[j]++] = static_cast<int32_t>(k);
+    }
+  }
 }
 
 namespace {
@@ -549,13 +555,6 @@ NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
   std::vector<int32_t> bucket_offsets(buckets + 1), order, keys;
   std::vector<char> active(n, 1), next_active(n, 0);
   bool soft = false;  // the smooth phase runs its sweeps to the end (its soft objective)
-  // Movable node index of a mesh node, for re-activating neighbours (sorted nodes: search).
-  auto local_of = [&](int32_t node) {
-    const auto it = std::lower_bound(problem.nodes.begin(), problem.nodes.end(), node);
-    return it != problem.nodes.end() && *it == node
-               ? static_cast<int32_t>(it - problem.nodes.begin())
-               : -1;
-  };
   auto run_sweeps = [&](int max_sweeps) {
     std::fill(active.begin(), active.end(), 1);
     double current_min, current_mean;
@@ -585,12 +584,9 @@ NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
         if (h > 0) largest_relative_move = std::max(largest_relative_move, moved / h);
         // Moves below a thousandth of the local edge length do not wake the neighbours.
         if (h > 0 && moved < 1e-3 * h) continue;
-        optimizer.for_each_hex(i, [&](int32_t, const HexCell& c, int) {
-          for (int32_t v : c) {
-            const int32_t j = local_of(v);
+        for (int32_t k = problem.node_hex_offsets[i]; k < problem.node_hex_offsets[i + 1]; ++k)
+          for (int32_t j : problem.hex_local_nodes[problem.node_hex[k]])
             if (j >= 0) next_active[j] = 1;
-          }
-        });
       }
       active.swap(next_active);
       ++stats.sweeps;

@@ -45,10 +45,14 @@ struct NodeProblem {
   std::vector<int32_t> hexes;             ///< every hex around a movable node, ascending, unique
   std::vector<int32_t> node_hex_offsets;  ///< CSR: movable node i -> indices into `hexes`
   std::vector<int32_t> node_hex;
+  /// Per entry of `hexes`, its corners as movable node indices (-1: a corner that does not
+  /// move): whom a move wakes, without a search per corner.
+  std::vector<std::array<int32_t, 8>> hex_local_nodes;
   SlideGeometry geometry;
 };
 
-/// Fills problem.hexes and the node -> hex CSR from `candidates` (ascending hex ids that include
+/// Fills problem.hexes, the node -> hex CSR and hex_local_nodes from `candidates` (ascending hex
+/// ids that include
 /// every hex with a movable node; others are skipped). Linear in the candidates; uses one int32
 /// per mesh node as scratch. Precondition: problem.nodes ascending.
 void node_problem_connect(NodeProblem& problem, const HexMesh& mesh,

@@ -49,6 +49,7 @@
 
 #include "experiments/bench_statistics.hpp"
 #include "experiments/cli.hpp"
+#include "experiments/process_huge_pages.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
 
@@ -297,7 +298,10 @@ void bench_history_append(const std::string& path, const json& merged, const Cli
   const json& context = merged["context"];
   record["machine"] = {{"host_name", context.value("host_name", std::string())},
                        {"num_cpus", context.value("num_cpus", 0)},
-                       {"mhz_per_cpu", context.value("mhz_per_cpu", 0)}};
+                       {"mhz_per_cpu", context.value("mhz_per_cpu", 0)},
+                       // The benchmark programs inherit the tunable from this process: a history
+                       // step from huge pages is told apart from a code change.
+                       {"huge_pages", process_uses_huge_pages()}};
   record["smoke"] = a.flag("--smoke");
   json benchmarks = json::object();
   const std::string tmp = path + ".run.json";

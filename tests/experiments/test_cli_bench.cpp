@@ -228,6 +228,8 @@ TEST(CliBench, HistoryGetsOneRecordPerRun) {
     const nlohmann::json j = nlohmann::json::parse(line);
     ++records;
     EXPECT_TRUE(j.contains("commit") && j.contains("date") && j.contains("machine")) << line;
+    EXPECT_TRUE(j["machine"].contains("huge_pages") && j["machine"]["huge_pages"].is_boolean())
+        << line;
     EXPECT_EQ(j["smoke"], true);
     const nlohmann::json& b = j["benchmarks"]["bench_check_rockerarm/real_time"];
     EXPECT_EQ(b["repetitions"], 3) << line;

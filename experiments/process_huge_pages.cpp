@@ -13,13 +13,6 @@ namespace {
 
 constexpr const char* hugetlb_tunable = "glibc.malloc.hugetlb";
 
-std::string kernel_huge_pages_mode() {
-  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
-  std::stringstream text;
-  text << in.rdbuf();
-  return huge_pages_mode(text.str());
-}
-
 bool running_under_valgrind() {
   const char* preload = std::getenv("LD_PRELOAD");
   return preload != nullptr && std::strstr(preload, "vgpreload") != nullptr;
@@ -34,6 +27,13 @@ std::string huge_pages_mode(const std::string& enabled) {
   return enabled.substr(open + 1, close - open - 1);
 }
 
+std::string huge_pages_kernel_mode() {
+  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::stringstream text;
+  text << in.rdbuf();
+  return huge_pages_mode(text.str());
+}
+
 std::optional<std::string> huge_pages_tunables(const char* current) {
   if (current == nullptr || *current == '\0') return std::string(hugetlb_tunable) + "=1";
   if (std::strstr(current, hugetlb_tunable) != nullptr) return std::nullopt;
@@ -46,7 +46,7 @@ void process_prefer_huge_pages(char** argv) {
 #else
   const char* opt_out = std::getenv("HEXREFINE_HUGE_PAGES");
   if (opt_out != nullptr && std::strcmp(opt_out, "0") == 0) return;
-  if (running_under_valgrind() || kernel_huge_pages_mode() != "madvise") return;
+  if (running_under_valgrind() || huge_pages_kernel_mode() != "madvise") return;
   const std::optional<std::string> tunables = huge_pages_tunables(std::getenv("GLIBC_TUNABLES"));
   if (!tunables) return;
   if (::setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;
@@ -56,7 +56,7 @@ void process_prefer_huge_pages(char** argv) {
 }
 
 bool process_uses_huge_pages() {
-  const std::string mode = kernel_huge_pages_mode();
+  const std::string mode = huge_pages_kernel_mode();
   if (mode == "always") return true;
   const char* current = std::getenv("GLIBC_TUNABLES");
   return mode == "madvise" && current != nullptr &&

@@ -25,6 +25,10 @@ namespace hexrefine {
 /// "madvise" from "always [madvise] never"; empty when there is none.
 std::string huge_pages_mode(const std::string& enabled);
 
+/// This kernel's mode: huge_pages_mode of /sys/kernel/mm/transparent_hugepage/enabled (empty
+/// where the file is missing).
+std::string huge_pages_kernel_mode();
+
 /// The GLIBC_TUNABLES value to re-execute with, given the current one (null: unset): the current
 /// tunables followed by glibc.malloc.hugetlb=1, or nothing when glibc.malloc.hugetlb is already set
 /// (by the user, or by this process' parent: the re-executed process never re-executes again).

@@ -4,7 +4,6 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "tests/cli_runner.hpp"
 #include "tests/fixtures.hpp"
@@ -30,13 +29,6 @@ TEST(ProcessHugePages, TunableIsAppendedOnce) {
   EXPECT_FALSE(huge_pages_tunables("glibc.malloc.arena_max=2:glibc.malloc.hugetlb=0").has_value());
 }
 
-std::string kernel_mode() {
-  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
-  std::stringstream text;
-  text << in.rdbuf();
-  return huge_pages_mode(text.str());
-}
-
 bool sanitized_build() {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   return true;
@@ -51,7 +43,7 @@ bool sanitized_build() {
 // (Debian: "madvise") it asserts the re-execution happened.
 TEST(ProcessHugePages, CommandReportsWhetherItUsesHugePages) {
   const auto dir = test_temp_dir("process_huge_pages");
-  const std::string mode = kernel_mode();
+  const std::string mode = huge_pages_kernel_mode();
   const std::string mesh = shared_mesh("abaqus_hex_2x2x2.inp");
   for (const bool opt_out : {false, true}) {
     SCOPED_TRACE(opt_out ? "HEXREFINE_HUGE_PAGES=0" : "default");

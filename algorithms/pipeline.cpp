@@ -162,6 +162,7 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
   clock.end("refine");
   clock.begin("check");
   std::vector<uint8_t> is_child;  // per output hex: made by refining an input hex
+  int64_t children = 0;
   {
     // A refined parent's children are a level above it (the input's own levels, if any, kept).
     const std::vector<int32_t>* parent = mesh_find_attribute(r.mesh, attribute_parent_hex);
@@ -181,12 +182,21 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
       }
     is_child.resize(r.mesh.hexes.size(), 0);
     for (int32_t h = 0; parent && level && h < r.mesh.hex_count(); ++h)
-      if ((is_child[h] = refined[(*parent)[h]]))
-        r.children_min_scaled_jacobian =
-            std::min(r.children_min_scaled_jacobian, hex_scaled_jacobian(hex_points(r.mesh, h)));
+      children += is_child[h] = refined[(*parent)[h]];
   }
+  // The minimum over the children: the checker's own when every hex is one (a full refinement,
+  // where a second pass would cost as much as the checker's quality samples), else a pass over
+  // them alone.
+  auto children_min = [&](const MeshCheckReport& check) {
+    if (children == r.mesh.hex_count()) return check.min_scaled_jacobian;
+    double m = 1;
+    for (int32_t h = 0; h < r.mesh.hex_count(); ++h)
+      if (is_child[h]) m = std::min(m, hex_scaled_jacobian(hex_points(r.mesh, h)));
+    return m;
+  };
 
   r.check = mesh_check(r.mesh, &input, o.refine.threads);
+  r.children_min_scaled_jacobian = children_min(r.check);
   clock.end("check");
   verdict_enforce(r.check, r.mesh, input, o, r.ablation, "the " + o.method + " refiner");
 
@@ -205,10 +215,7 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
       clock.end("smooth");
       clock.begin("check (smoothed)");
       r.smoothed_check = mesh_check(r.mesh, &input, o.refine.threads);
-      double children = 1;
-      for (int32_t h = 0; h < r.mesh.hex_count(); ++h)
-        if (is_child[h]) children = std::min(children, hex_scaled_jacobian(hex_points(r.mesh, h)));
-      r.smoothed_children_min_scaled_jacobian = children;
+      r.smoothed_children_min_scaled_jacobian = children_min(*r.smoothed_check);
       clock.end("check_smoothed");
       verdict_enforce(*r.smoothed_check, r.mesh, input, o, r.ablation, "smoothing");
     }

@@ -40,5 +40,24 @@ TEST(Pipeline, ChildrenMinimumLeavesOutUntouchedInputHexes) {
   }
 }
 
+// A full refinement: every output hex is a child, and the children's minimum is the checker's
+// (taken from it rather than computed twice), here below every template's value: the corner
+// hex's children inherit its distortion.
+TEST(Pipeline, FullRefinementChildrenMinimumIsTheMeshMinimum) {
+  const std::array<int, 3> dims{3, 3, 3};
+  HexMesh m = generate_brick({.dims = dims, .size = {3, 3, 3}});
+  m.points[brick_node(dims, 0, 0, 0)] = Eigen::Vector3d(-1.5, -1.5, -1.5);
+  PipelineOptions o;
+  o.method = "selective";
+  o.select = {"all"};
+  o.refine.placement.method = PlacementMethod::trilinear;
+  const PipelineResult r = pipeline_run(m, o);
+  EXPECT_EQ(r.refined_parents, 27);
+  EXPECT_EQ(r.mesh.hex_count(), 27 * 27);
+  EXPECT_DOUBLE_EQ(r.children_min_scaled_jacobian, r.check.min_scaled_jacobian);
+  EXPECT_LT(r.children_min_scaled_jacobian, 0.25);
+  EXPECT_GT(r.children_min_scaled_jacobian, 0.0);
+}
+
 }  // namespace
 }  // namespace hexrefine

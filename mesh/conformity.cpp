@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -152,6 +153,24 @@ BoundarySurface boundary_surface(const HexMesh& mesh, std::vector<HexFaceSlot> s
   return s;
 }
 
+/// Indices of the faces of `surface` for which is_defect(index) holds, ascending; faces are
+/// tested per chunk on up to `threads` threads.
+template <class Test>
+std::vector<int32_t> boundary_faces_where(int threads, const BoundarySurface& surface,
+                                          Test is_defect) {
+  constexpr int64_t chunk_faces = 1 << 12;
+  const int64_t faces = static_cast<int64_t>(surface.quads.size());
+  std::vector<std::vector<int32_t>> found(
+      static_cast<size_t>(parallel_chunk_count(faces, chunk_faces)));
+  parallel_chunks(threads, faces, chunk_faces, [&](int64_t chunk, int64_t begin, int64_t end) {
+    for (int32_t i = static_cast<int32_t>(begin); i < end; ++i)
+      if (is_defect(i)) found[chunk].push_back(i);
+  });
+  std::vector<int32_t> out;
+  for (const std::vector<int32_t>& list : found) out.insert(out.end(), list.begin(), list.end());
+  return out;
+}
+
 /// A boundary face across reference faces (see conformity.hpp): each corner on a reference face
 /// whose normal is within mesh_check_across_angle_degrees of the face's, the centroid within
 /// mesh_check_across_chord x the face's diameter of a reference face near it. Conservative: a
@@ -198,7 +217,7 @@ double mesh_volume(const HexMesh& mesh) {
 /// search the neighbouring cells. The cell size is an irrational multiple of the mean spacing so
 /// structured grids do not put their points on the walls. Worst case (many points in one cell)
 /// is quadratic in that cell.
-int64_t count_duplicate_nodes(const HexMesh& mesh) {
+int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
   const auto [lo, hi] = mesh_bounding_box(mesh);
@@ -219,13 +238,16 @@ int64_t count_duplicate_nodes(const HexMesh& mesh) {
   };
   auto cell_of = [&](int64_t x, int64_t y, int64_t z) { return (z * dims[1] + y) * dims[0] + x; };
   const int64_t cells = dims[0] * dims[1] * dims[2];
+  constexpr int64_t chunk_points = 1 << 12;
   std::vector<int64_t> cell_of_point(n);
+  parallel_chunks(threads, n, chunk_points, [&](int64_t, int64_t begin, int64_t end) {
+    for (int64_t i = begin; i < end; ++i) {
+      const Eigen::Vector3d& p = mesh.points[i];
+      cell_of_point[i] = cell_of(cell_index(p[0], 0), cell_index(p[1], 1), cell_index(p[2], 2));
+    }
+  });
   std::vector<uint32_t> cell_end(static_cast<size_t>(cells), 0);  // counts, starts, then ends
-  for (int32_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d& p = mesh.points[i];
-    cell_of_point[i] = cell_of(cell_index(p[0], 0), cell_index(p[1], 1), cell_index(p[2], 2));
-    ++cell_end[cell_of_point[i]];
-  }
+  for (int64_t c : cell_of_point) ++cell_end[c];
   uint32_t running = 0;
   for (uint32_t& c : cell_end) {
     const uint32_t count = c;
@@ -236,35 +258,41 @@ int64_t count_duplicate_nodes(const HexMesh& mesh) {
   for (int32_t i = 0; i < n; ++i) sorted[cell_end[cell_of_point[i]]++] = i;
   auto cell_begin = [&](int64_t c) { return c == 0 ? uint32_t{0} : cell_end[c - 1]; };
 
+  // Pairs are compared per chunk of cells, then per chunk of points near a wall, on every thread;
+  // a close pair marks its higher node (atomically: two chunks may mark the same node).
   std::vector<char> duplicate(n, 0);
   auto compare = [&](int32_t i, int32_t j) {
     if (i != j && (mesh.points[i] - mesh.points[j]).norm() <= tolerance)
-      duplicate[std::max(i, j)] = 1;
+      std::atomic_ref<char>(duplicate[std::max(i, j)]).store(1, std::memory_order_relaxed);
   };
-  for (int64_t c = 0; c < cells; ++c)
-    for (uint32_t a = cell_begin(c); a < cell_end[c]; ++a)
-      for (uint32_t b = a + 1; b < cell_end[c]; ++b) compare(sorted[a], sorted[b]);
-  for (int32_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d& p = mesh.points[i];
-    int64_t k[3];
-    int low[3], high[3];
-    bool near_wall = false;
-    for (int d = 0; d < 3; ++d) {
-      k[d] = cell_index(p[d], d);
-      const double wall = origin[d] + static_cast<double>(k[d]) * cell;
-      low[d] = k[d] > 0 && p[d] - wall <= tolerance ? -1 : 0;
-      high[d] = k[d] + 1 < dims[d] && wall + cell - p[d] <= tolerance ? 1 : 0;
-      near_wall = near_wall || low[d] || high[d];
+  parallel_chunks(threads, cells, chunk_points, [&](int64_t, int64_t begin, int64_t end) {
+    for (int64_t c = begin; c < end; ++c)
+      for (uint32_t a = cell_begin(c); a < cell_end[c]; ++a)
+        for (uint32_t b = a + 1; b < cell_end[c]; ++b) compare(sorted[a], sorted[b]);
+  });
+  parallel_chunks(threads, n, chunk_points, [&](int64_t, int64_t begin, int64_t end) {
+    for (int32_t i = static_cast<int32_t>(begin); i < end; ++i) {
+      const Eigen::Vector3d& p = mesh.points[i];
+      int64_t k[3];
+      int low[3], high[3];
+      bool near_wall = false;
+      for (int d = 0; d < 3; ++d) {
+        k[d] = cell_index(p[d], d);
+        const double wall = origin[d] + static_cast<double>(k[d]) * cell;
+        low[d] = k[d] > 0 && p[d] - wall <= tolerance ? -1 : 0;
+        high[d] = k[d] + 1 < dims[d] && wall + cell - p[d] <= tolerance ? 1 : 0;
+        near_wall = near_wall || low[d] || high[d];
+      }
+      if (!near_wall) continue;
+      for (int dz = low[2]; dz <= high[2]; ++dz)
+        for (int dy = low[1]; dy <= high[1]; ++dy)
+          for (int dx = low[0]; dx <= high[0]; ++dx) {
+            if (dx == 0 && dy == 0 && dz == 0) continue;
+            const int64_t c = cell_of(k[0] + dx, k[1] + dy, k[2] + dz);
+            for (uint32_t b = cell_begin(c); b < cell_end[c]; ++b) compare(i, sorted[b]);
+          }
     }
-    if (!near_wall) continue;
-    for (int dz = low[2]; dz <= high[2]; ++dz)
-      for (int dy = low[1]; dy <= high[1]; ++dy)
-        for (int dx = low[0]; dx <= high[0]; ++dx) {
-          if (dx == 0 && dy == 0 && dz == 0) continue;
-          const int64_t c = cell_of(k[0] + dx, k[1] + dy, k[2] + dz);
-          for (uint32_t b = cell_begin(c); b < cell_end[c]; ++b) compare(i, sorted[b]);
-        }
-  }
+  });
   return std::count(duplicate.begin(), duplicate.end(), 1);
 }
 
@@ -277,7 +305,7 @@ int scaled_jacobian_bin(double v) {
 }  // namespace
 
 MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int threads) {
-  mesh_validate_ids(mesh, "mesh");
+  mesh_validate_ids(mesh, "mesh", threads);
   if (reference) mesh_validate_ids(*reference, "reference mesh");
   MeshCheckReport r;
   r.hexes = mesh.hex_count();
@@ -289,7 +317,7 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
       for (int32_t v : c) used[v] = 1;
     r.unused_nodes = std::count(used.begin(), used.end(), 0);
   }
-  r.duplicate_nodes = count_duplicate_nodes(mesh);
+  r.duplicate_nodes = count_duplicate_nodes(mesh, threads);
   HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, threads);
   r.nonmanifold_faces = static_cast<int64_t>(adjacency.nonmanifold_faces.size());
 
@@ -311,12 +339,13 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   parallel_chunks(threads, r.hexes, chunk_hexes, [&](int64_t chunk, int64_t begin, int64_t end) {
     ChunkSums& s = sums[chunk];
     size_t doublet_defects = 0;
+    std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin));
+    mesh_scaled_jacobians(mesh, static_cast<int32_t>(begin), scaled_jacobians);
     for (int32_t h = static_cast<int32_t>(begin); h < end; ++h) {
-      const HexCorners p = hex_points(mesh, h);
-      const double sj = hex_scaled_jacobian(p);
+      const double sj = scaled_jacobians[h - begin];
       s.scaled_jacobian_sum += sj;
       s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
-      s.volume += hex_volume(p);
+      s.volume += hex_volume(hex_points(mesh, h));
       ++s.histogram[scaled_jacobian_bin(sj)];
       if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
         s.defects.push_back(h);
@@ -380,7 +409,7 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
     const BoundarySurface reference_surface =
         boundary_surface(*reference, hex_face_adjacency_build(*reference, threads).boundary_faces);
     const QuadGrid grid(reference_surface.quads, reference_surface.tolerances);
-    for (size_t i = 0; i < surface.quads.size(); ++i) {
+    non_conformal = boundary_faces_where(threads, surface, [&](int32_t i) {
       const Quad& q = surface.quads[i];
       const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
       const bool on_reference = grid.find(centroid, [&](int32_t j) {
@@ -389,9 +418,8 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
             return false;
         return true;
       });
-      if (!on_reference && !face_lies_across_reference(q, grid, reference_surface))
-        non_conformal.push_back(static_cast<int32_t>(i));
-    }
+      return !on_reference && !face_lies_across_reference(q, grid, reference_surface);
+    });
     r.reference_compared = true;
     r.reference_volume = mesh_volume(*reference);
     r.reference_planar_faced = true;
@@ -406,12 +434,11 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
                             r.boundary_area_relative_error <= mesh_check_geometry_tolerance);
   } else {
     const QuadGrid grid(surface.quads, surface.tolerances);
-    for (size_t i = 0; i < surface.quads.size(); ++i) {
+    non_conformal = boundary_faces_where(threads, surface, [&](int32_t i) {
       const Quad& q = surface.quads[i];
       const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
-      if (grid.find(centroid, [&](int32_t j) { return j != static_cast<int32_t>(i); }))
-        non_conformal.push_back(static_cast<int32_t>(i));
-    }
+      return grid.find(centroid, [&](int32_t j) { return j != i; });
+    });
   }
   r.non_conformal_faces = static_cast<int64_t>(non_conformal.size());
   for (int32_t i : non_conformal) defects.push_back(surface.slots[i].hex);

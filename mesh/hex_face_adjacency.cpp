@@ -41,21 +41,38 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
                          std::to_string(hex_face_adjacency_max_hexes));
   const int32_t nodes = mesh.point_count();
 
-  // Counting sort of the slots by lowest node: bucket_end[a] first counts, then holds where
-  // node a's bucket starts, and after the fill where it ends (no separate cursor array).
-  std::vector<uint32_t> bucket_end(static_cast<size_t>(nodes), 0);
-  for (const HexCell& c : mesh.hexes)
-    for (int lf = 0; lf < 6; ++lf) ++bucket_end[face_lowest_node(c, lf)];
+  // Counting sort of the slots by lowest node, over `parts` contiguous hex ranges at once: each
+  // range counts its faces per node, a prefix over (node, range) gives each range its place in
+  // every bucket, and each range scatters its slots there. The slots of a bucket stay in hex
+  // order, so the array is the same for any thread count. offsets[p][a] first counts, then holds
+  // where range p's part of node a's bucket starts, and after the scatter where it ends: the last
+  // range's ends are the buckets' ends.
+  const int parts =
+      static_cast<int>(std::clamp<int64_t>(threads, 1, std::max<int64_t>(hexes / 4096, 1)));
+  auto part_begin = [&](int p) { return static_cast<int32_t>(int64_t{hexes} * p / parts); };
+  std::vector<std::vector<uint32_t>> offsets(static_cast<size_t>(parts));
+  parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
+    std::vector<uint32_t>& count = offsets[p];
+    count.assign(static_cast<size_t>(nodes), 0);
+    for (int32_t h = part_begin(static_cast<int>(p)); h < part_begin(static_cast<int>(p) + 1); ++h)
+      for (int lf = 0; lf < 6; ++lf) ++count[face_lowest_node(mesh.hexes[h], lf)];
+  });
   uint32_t running = 0;
-  for (uint32_t& b : bucket_end) {
-    const uint32_t count = b;
-    b = running;
-    running += count;
-  }
+  for (int32_t node = 0; node < nodes; ++node)
+    for (int p = 0; p < parts; ++p) {
+      const uint32_t count = offsets[p][node];
+      offsets[p][node] = running;
+      running += count;
+    }
   std::vector<uint32_t> slots(running);
-  for (int32_t h = 0; h < hexes; ++h)
-    for (int lf = 0; lf < 6; ++lf)
-      slots[bucket_end[face_lowest_node(mesh.hexes[h], lf)]++] = static_cast<uint32_t>(h) * 6 + lf;
+  parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
+    std::vector<uint32_t>& cursor = offsets[p];
+    for (int32_t h = part_begin(static_cast<int>(p)); h < part_begin(static_cast<int>(p) + 1); ++h)
+      for (int lf = 0; lf < 6; ++lf)
+        slots[cursor[face_lowest_node(mesh.hexes[h], lf)]++] = static_cast<uint32_t>(h) * 6 + lf;
+  });
+  const std::vector<uint32_t> bucket_end = std::move(offsets.back());
+  offsets.clear();
 
   HexFaceAdjacency a;
   if (neighbors) a.hex_neighbors.resize(static_cast<size_t>(hexes));

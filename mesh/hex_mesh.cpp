@@ -1,6 +1,7 @@
 #include "mesh/hex_mesh.hpp"
 
 #include "mesh/error.hpp"
+#include "mesh/parallel.hpp"
 
 namespace hexrefine {
 
@@ -25,20 +26,24 @@ std::vector<int32_t>& mesh_attribute(HexMesh& mesh, std::string_view name, int32
   return mesh.attributes.back().values;
 }
 
-void mesh_validate_ids(const HexMesh& mesh, const std::string& what) {
+void mesh_validate_ids(const HexMesh& mesh, const std::string& what, int threads) {
   const int64_t n = static_cast<int64_t>(mesh.points.size());
-  for (size_t h = 0; h < mesh.hexes.size(); ++h) {
-    const HexCell& c = mesh.hexes[h];
-    for (int i = 0; i < 8; ++i) {
-      if (c[i] < 0 || c[i] >= n)
-        throw InputError(what + ": hex " + std::to_string(h) + " refers to node " +
-                         std::to_string(c[i]) + ", expected 0.." + std::to_string(n - 1));
-      for (int j = 0; j < i; ++j)
-        if (c[j] == c[i])
-          throw InputError(what + ": hex " + std::to_string(h) + " repeats node " +
-                           std::to_string(c[i]) + " (degenerate hex)");
+  // Per chunk of hexes; the first chunk's error is the one rethrown, so the message names the
+  // lowest offending hex for any thread count.
+  parallel_chunks(threads, mesh.hex_count(), 1 << 16, [&](int64_t, int64_t begin, int64_t end) {
+    for (int64_t h = begin; h < end; ++h) {
+      const HexCell& c = mesh.hexes[h];
+      for (int i = 0; i < 8; ++i) {
+        if (c[i] < 0 || c[i] >= n)
+          throw InputError(what + ": hex " + std::to_string(h) + " refers to node " +
+                           std::to_string(c[i]) + ", expected 0.." + std::to_string(n - 1));
+        for (int j = 0; j < i; ++j)
+          if (c[j] == c[i])
+            throw InputError(what + ": hex " + std::to_string(h) + " repeats node " +
+                             std::to_string(c[i]) + " (degenerate hex)");
+      }
     }
-  }
+  });
   for (const HexAttribute& a : mesh.attributes)
     if (a.values.size() != mesh.hexes.size())
       throw InputError(what + ": attribute '" + a.name + "' has " +

@@ -48,8 +48,9 @@ const std::vector<int32_t>* mesh_find_attribute(const HexMesh& mesh, std::string
 std::vector<int32_t>& mesh_attribute(HexMesh& mesh, std::string_view name, int32_t fill = 0);
 
 /// Throws InputError naming the hex if a node id is out of range, a hex repeats a node, or an
-/// attribute has the wrong length; `what` names the source (e.g. the file).
-void mesh_validate_ids(const HexMesh& mesh, const std::string& what);
+/// attribute has the wrong length; `what` names the source (e.g. the file). The first offending
+/// hex by id is named, whatever `threads` (>= 1, how many check at once).
+void mesh_validate_ids(const HexMesh& mesh, const std::string& what, int threads = 1);
 
 /// Centroid (mean of the 8 corners) of hex `h`.
 Eigen::Vector3d hex_centroid(const HexMesh& mesh, int32_t h);

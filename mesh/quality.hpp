@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <span>
 #include <vector>
 
 #include "mesh/hex_mesh.hpp"
@@ -77,9 +78,10 @@ double hex_condition(const HexCorners& p);
 /// hex_metric_max if the shortest edge has zero length. Acceptable range (Verdict): [1, 1.3].
 double hex_edge_ratio(const HexCorners& p);
 
-/// Volume: the exact integral of det J of the trilinear map over the unit cube (2x2x2 Gauss points
-/// integrate that polynomial exactly). Signed: negative for an inside-out hex. Unit cube 1; equals
-/// the polyhedron's volume when all faces are planar.
+/// Volume: the exact integral of det J of the trilinear map over the unit cube (Grandy's
+/// long-diagonal formula: three triple products of edge and diagonal vectors, / 12). Signed:
+/// negative for an inside-out hex. Unit cube 1; equals the polyhedron's volume when all faces are
+/// planar.
 double hex_volume(const HexCorners& p);
 
 /// True if the hex is a positively oriented parallelepiped up to rounding: its trilinear map is
@@ -92,6 +94,11 @@ bool hex_is_parallelepiped(const HexCorners& p);
 
 /// hex_scaled_jacobian of every hex, indexed by hex id. Precondition: mesh_validate_ids holds.
 std::vector<double> mesh_scaled_jacobians(const HexMesh& mesh);
+
+/// hex_scaled_jacobian of hexes first .. first + out.size() - 1 into `out`, bit-identical to
+/// calling it hex by hex, two hexes per evaluation (the checker's and the refiners' quality
+/// passes). Precondition: mesh_validate_ids holds and the hexes exist.
+void mesh_scaled_jacobians(const HexMesh& mesh, int32_t first, std::span<double> out);
 
 /// Minimum hex_scaled_jacobian over the mesh; 1 (a perfect hex) for an empty mesh so reports stay
 /// finite. Precondition: mesh_validate_ids holds.

@@ -340,6 +340,35 @@ TEST(Conformity, RefusesBadIds) {
   EXPECT_THROW(mesh_check(m), InputError);
 }
 
+TEST(Conformity, BadIdsAreNamedByTheLowestHexOnAnyThreadCount) {
+  HexMesh m = fixture_brick(41, 41, 41);  // 68,921 hexes: two chunks of the id validation
+  m.hexes[68000][2] = m.hexes[68000][5];
+  m.hexes[100][3] = m.point_count();
+  for (int threads : {1, 2}) {
+    try {
+      mesh_check(m, nullptr, threads);
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), "mesh: hex 100 refers to node " +
+                                           std::to_string(m.point_count()) + ", expected 0.." +
+                                           std::to_string(m.point_count() - 1));
+    }
+  }
+}
+
+TEST(Conformity, DuplicateNodesOnAnyThreadCount) {
+  // 29,791 grid nodes (eight chunks of the search) and 300 copies of distinct nodes: at distance
+  // 0 and 0.5 x the tolerance they are duplicates, at 2 x it they are not.
+  HexMesh m = fixture_brick(30, 30, 30);
+  const double tolerance = mesh_check_duplicate_tolerance * std::sqrt(3.0 * 30 * 30);
+  for (int i = 0; i < 300; ++i) {
+    const double scale = (i % 3 == 0) ? 0.0 : (i % 3 == 1 ? 0.5 : 2.0) * tolerance;
+    m.points.push_back(m.points[97 * i] + scale * Eigen::Vector3d(1, 2, 2) / 3.0);
+  }
+  EXPECT_EQ(mesh_check(m, nullptr, 1).duplicate_nodes, 200);
+  EXPECT_EQ(mesh_check(m, nullptr, 2).duplicate_nodes, 200);
+}
+
 TEST(Conformity, EmptyMesh) {
   const MeshCheckReport r = mesh_check(HexMesh{});
   EXPECT_EQ(r.hexes, 0);

@@ -163,6 +163,11 @@ double hex_scaled_jacobian(const HexCorners& p) {
   return lanes_scaled_jacobian(lanes_corners(p, p))[0];
 }
 
+std::array<double, 2> hex_scaled_jacobian_pair(const HexCorners& a, const HexCorners& b) {
+  const Lanes q = lanes_scaled_jacobian(lanes_corners(a, b));
+  return {q[0], q[1]};
+}
+
 double hex_jacobian(const HexCorners& p) {
   double best = hex_centre_jacobian(p).determinant();
   for (int v = 0; v < 8; ++v) best = std::min(best, hex_corner_jacobian(p, v).determinant());

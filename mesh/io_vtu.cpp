@@ -181,6 +181,46 @@ std::string xml_attribute(std::string_view tag, std::string_view name) {
   return "";
 }
 
+/// An integer array of <Cells> left in the (mapped) file, raw and uncompressed: its values are
+/// read where they lie when the hexes are built, so an 11 M-hex file's connectivity, offsets and
+/// types are not first copied into arrays of their own (as large as the hexes, and fresh memory
+/// costs about as much to fault in as to fill).
+struct CellsArrayInFile {
+  std::string_view bytes;
+  size_t tag = 0;          ///< position of its <DataArray> tag, for messages
+  int size = 0;            ///< bytes per value: 1, 2, 4 or 8
+  bool is_signed = false;  ///< char, short, int, long (else the unsigned types)
+  int64_t count() const { return static_cast<int64_t>(bytes.size()) / size; }
+  /// Value i (< count()); InputError naming `what` for an unsigned 64-bit value beyond int64.
+  [[gnu::always_inline]] int64_t at(int64_t i, const std::string& path,
+                                    const std::string& what) const {
+    const char* p = bytes.data() + i * size;
+    auto load = [&](auto zero) {
+      decltype(zero) v;
+      std::memcpy(&v, p, sizeof v);
+      return v;
+    };
+    switch (size) {
+      case 1:
+        return is_signed ? int64_t{load(int8_t{})} : int64_t{load(uint8_t{})};
+      case 2:
+        return is_signed ? int64_t{load(int16_t{})} : int64_t{load(uint16_t{})};
+      case 4:
+        return is_signed ? int64_t{load(int32_t{})} : int64_t{load(uint32_t{})};
+      default: {
+        if (is_signed) return load(int64_t{});
+        const uint64_t v = load(uint64_t{});
+        if (v > static_cast<uint64_t>(INT64_MAX)) too_large(v, path, what);
+        return static_cast<int64_t>(v);
+      }
+    }
+  }
+  [[noreturn, gnu::noinline, gnu::cold]] static void too_large(uint64_t v, const std::string& path,
+                                                               const std::string& what) {
+    throw InputError(path + ": " + what + ": value " + std::to_string(v) + " too large");
+  }
+};
+
 /// Calls f(value as double, value as int64) for each of the `count` little-endian values of
 /// VTK type `type` (legacy name) in `bytes`; InputError naming `what` if the sizes differ.
 template <class F>
@@ -298,6 +338,20 @@ HexMesh vtu_read(const std::string& path, std::string_view text, const FileBytes
   // read), offsets as Int64: a 10 M-hex file's arrays in half the memory of Int64 throughout.
   std::vector<int32_t> connectivity, types;
   std::vector<int64_t> offsets;
+  // Slots 0, 1, 2: connectivity, offsets, types. Raw uncompressed integer arrays stay in the
+  // file (cells_in_file[slot].size > 0) and are read there when the hexes are built.
+  std::array<CellsArrayInFile, 3> cells_in_file{};
+  const std::string cells_names[3] = {"connectivity", "offsets", "types"};
+  auto cells_append = [&](int slot, int64_t v, size_t tag) {
+    if (slot == 1) return offsets.push_back(v);
+    if (v < INT32_MIN || v > INT32_MAX)
+      fail_at(tag, "DataArray '" + cells_names[slot] + "' holds " + std::to_string(v) +
+                       ", out of range");
+    (slot == 0 ? connectivity : types).push_back(static_cast<int32_t>(v));
+  };
+  auto cells_reserve = [&](int slot, size_t n) {
+    slot == 1 ? offsets.reserve(n) : (slot == 0 ? connectivity : types).reserve(n);
+  };
   bool have_points = false;
   struct Pending {
     std::string name;
@@ -414,31 +468,30 @@ HexMesh vtu_read(const std::string& path, std::string_view text, const FileBytes
       if (in_file && file) file->release(data);
       have_points = true;
     } else if (section == in_cells && section >= 0) {
-      std::vector<int32_t>* out32 = name == "connectivity" ? &connectivity
-                                    : name == "types"      ? &types
-                                                           : nullptr;
-      if (out32 == nullptr && name != "offsets")
-        fail_at(p, "unknown Cells DataArray '" + name + "'");
-      auto append = [&](int64_t v) {
-        if (out32 == nullptr) return offsets.push_back(v);
-        if (v < INT32_MIN || v > INT32_MAX)
-          fail_at(p, "DataArray '" + name + "' holds " + std::to_string(v) + ", out of range");
-        out32->push_back(static_cast<int32_t>(v));
-      };
-      auto reserve = [&](size_t n) { out32 ? out32->reserve(n) : offsets.reserve(n); };
+      const int slot = name == "connectivity" ? 0
+                       : name == "offsets"    ? 1
+                       : name == "types"      ? 2
+                                              : -1;
+      if (slot < 0) fail_at(p, "unknown Cells DataArray '" + name + "'");
       if (binary) {
         const int value_size = vtk_type_size(legacy_type);
         if (value_size <= 0 || data.size() % static_cast<size_t>(value_size) != 0)
           fail_at(p, what + ": " + std::to_string(data.size()) + " bytes, not whole values");
-        reserve(data.size() / static_cast<size_t>(value_size));
-        vtu_binary_values(path, data, legacy_type, static_cast<int64_t>(data.size()) / value_size,
-                          what, [&](double, int64_t v) { append(v); });
-        if (in_file && file) file->release(data);
+        if (in_file && vtk_type_is_integer(legacy_type)) {
+          cells_in_file[slot] = CellsArrayInFile{data, p, value_size,
+                                                 legacy_type == "char" || legacy_type == "short" ||
+                                                     legacy_type == "int" || legacy_type == "long"};
+        } else {
+          cells_reserve(slot, data.size() / static_cast<size_t>(value_size));
+          vtu_binary_values(path, data, legacy_type, static_cast<int64_t>(data.size()) / value_size,
+                            what, [&](double, int64_t v) { cells_append(slot, v, p); });
+          if (in_file && file) file->release(data);
+        }
       }
       size_t read = 0;
       while (!binary && !in.at_end()) {
         if (read++ >= static_cast<size_t>(size)) in.fail("too many values");
-        append(in.integer(what));
+        cells_append(slot, in.integer(what), p);
       }
     } else if (section == in_cell_data && section >= 0) {
       cell_arrays.push_back({name, tag_end + 1, in.line(), legacy_type, std::move(bytes),
@@ -450,41 +503,86 @@ HexMesh vtu_read(const std::string& path, std::string_view text, const FileBytes
     p = close;
   }
   if (!have_points) fail_at(piece, "no <Points> DataArray");
-  if (static_cast<int64_t>(offsets.size()) != nc || static_cast<int64_t>(types.size()) != nc)
-    fail_at(piece, "Cells offsets/types need NumberOfCells = " + std::to_string(nc) + " values");
-  st.hex_of_cell.assign(static_cast<size_t>(nc), -1);
-  st.mesh.hexes.reserve(static_cast<size_t>(nc));
-  int64_t start = 0;
-  for (int64_t c = 0; c < nc; ++c) {
-    const int64_t end = offsets[c];
-    if (end < start || end > static_cast<int64_t>(connectivity.size()))
-      fail_at(piece,
-              "cell " + std::to_string(c) + ": offsets not increasing or beyond the connectivity");
-    const int kind = vtk_cell_kind(types[c]);
-    if (kind == -1)
-      fail_at(piece,
-              "cell " + std::to_string(c) + " has VTK type " + std::to_string(types[c]) +
-                  ", a volume cell that is not a linear hexahedron (only hexes are supported)");
-    if (kind == -2)
-      fail_at(piece,
-              "cell " + std::to_string(c) + " has unknown VTK type " + std::to_string(types[c]));
-    if (kind == 1) {
-      if (end - start != 8)
-        fail_at(piece, "hexahedron " + std::to_string(c) + " has " + std::to_string(end - start) +
-                           " nodes, expected 8");
-      HexCell h;
-      for (int k = 0; k < 8; ++k) {
-        const int64_t v = connectivity[start + k];
-        if (v < 0 || v >= np)
-          fail_at(piece, "cell " + std::to_string(c) + " refers to point " + std::to_string(v) +
-                             ", expected 0.." + std::to_string(np - 1));
-        h[k] = static_cast<int32_t>(v);
+  // Arrays left in the file whose partners were not (encodings mixed within <Cells>) are read
+  // into arrays after all, as the others were.
+  const bool all_in_file = cells_in_file[0].size && cells_in_file[1].size && cells_in_file[2].size;
+  for (int slot = 0; slot < 3 && !all_in_file; ++slot) {
+    const CellsArrayInFile& a = cells_in_file[slot];
+    if (!a.size) continue;
+    const std::string what = "values of DataArray '" + cells_names[slot] + "'";
+    cells_reserve(slot, static_cast<size_t>(a.count()));
+    for (int64_t i = 0; i < a.count(); ++i) cells_append(slot, a.at(i, path, what), a.tag);
+    if (file) file->release(a.bytes);
+  }
+  // The hexes from the cells: `connectivity(i)`, `offset(c)`, `type(c)` give the arrays' values
+  // wherever they are (in the file, range-checked as they are read, or decoded above).
+  auto build = [&](int64_t connectivity_count, int64_t offset_count, int64_t type_count,
+                   auto connectivity_at, auto offset_at, auto type_at) {
+    if (offset_count != nc || type_count != nc)
+      fail_at(piece, "Cells offsets/types need NumberOfCells = " + std::to_string(nc) + " values");
+    st.hex_of_cell.assign(static_cast<size_t>(nc), -1);
+    st.mesh.hexes.reserve(static_cast<size_t>(nc));
+    int64_t start = 0;
+    for (int64_t c = 0; c < nc; ++c) {
+      const int64_t end = offset_at(c);
+      if (end < start || end > connectivity_count)
+        fail_at(piece, "cell " + std::to_string(c) +
+                           ": offsets not increasing or beyond the connectivity");
+      const int32_t type = type_at(c);
+      const int kind = vtk_cell_kind(type);
+      if (kind == -1)
+        fail_at(piece,
+                "cell " + std::to_string(c) + " has VTK type " + std::to_string(type) +
+                    ", a volume cell that is not a linear hexahedron (only hexes are supported)");
+      if (kind == -2)
+        fail_at(piece,
+                "cell " + std::to_string(c) + " has unknown VTK type " + std::to_string(type));
+      if (kind == 1) {
+        if (end - start != 8)
+          fail_at(piece, "hexahedron " + std::to_string(c) + " has " + std::to_string(end - start) +
+                             " nodes, expected 8");
+        HexCell h;
+        for (int k = 0; k < 8; ++k) {
+          const int64_t v = connectivity_at(start + k);
+          if (v < 0 || v >= np)
+            fail_at(piece, "cell " + std::to_string(c) + " refers to point " + std::to_string(v) +
+                               ", expected 0.." + std::to_string(np - 1));
+          h[k] = static_cast<int32_t>(v);
+        }
+        if (type == 11) std::swap(h[2], h[3]), std::swap(h[6], h[7]);
+        st.hex_of_cell[c] = static_cast<int32_t>(st.mesh.hexes.size());
+        st.mesh.hexes.push_back(h);
+      } else {
+        for (int64_t i = start; i < end; ++i) connectivity_at(i);  // range-checked all the same
       }
-      if (types[c] == 11) std::swap(h[2], h[3]), std::swap(h[6], h[7]);
-      st.hex_of_cell[c] = static_cast<int32_t>(st.mesh.hexes.size());
-      st.mesh.hexes.push_back(h);
+      start = end;
     }
-    start = end;
+    for (int64_t i = start; i < connectivity_count; ++i) connectivity_at(i);
+  };
+  if (all_in_file) {
+    const CellsArrayInFile &cells = cells_in_file[0], &ends = cells_in_file[1],
+                           &kinds = cells_in_file[2];
+    const std::string what[3] = {"values of DataArray 'connectivity'",
+                                 "values of DataArray 'offsets'", "values of DataArray 'types'"};
+    auto int32_value = [&](int slot, int64_t i) {
+      const int64_t v = cells_in_file[slot].at(i, path, what[slot]);
+      if (v < INT32_MIN || v > INT32_MAX)
+        fail_at(cells_in_file[slot].tag, "DataArray '" + cells_names[slot] + "' holds " +
+                                             std::to_string(v) + ", out of range");
+      return static_cast<int32_t>(v);
+    };
+    build(
+        cells.count(), ends.count(), kinds.count(),
+        [&](int64_t i) { return int64_t{int32_value(0, i)}; },
+        [&](int64_t c) { return ends.at(c, path, what[1]); },
+        [&](int64_t c) { return int32_value(2, c); });
+    if (file)
+      for (const CellsArrayInFile& a : cells_in_file) file->release(a.bytes);
+  } else {
+    build(
+        static_cast<int64_t>(connectivity.size()), static_cast<int64_t>(offsets.size()),
+        static_cast<int64_t>(types.size()), [&](int64_t i) { return int64_t{connectivity[i]}; },
+        [&](int64_t c) { return offsets[c]; }, [&](int64_t c) { return types[c]; });
   }
   // The hexes hold the cells now: the file's arrays go before the attributes are built.
   std::vector<int32_t>().swap(connectivity);

@@ -5,6 +5,8 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <set>
 #include <string>
 
 #include "cli_runner.hpp"
@@ -119,6 +121,65 @@ TEST(IoVtuData, AppendedRawAndBase64WithAndWithoutZlib) {
       io_write_text(p, text);
       expect_unit_cube(mesh_read(p.string()));
     }
+}
+
+TEST(IoVtuData, RawCellsArraysReadInTheFileMixedWithTextAndCheckedAsDecodedOnes) {
+  // Raw appended <Cells> arrays are read where they lie in the file; with a partner in another
+  // encoding they are decoded like it; either way every value is checked as a decoded one is.
+  const auto dir = test_temp_dir("io_vtu_cells_in_file");
+  // `text_names`: arrays written as ASCII; `replace`: name -> (type, raw bytes) overrides.
+  auto write = [&](const std::string& file, const std::set<std::string>& text_names,
+                   const std::map<std::string, std::pair<std::string, std::string>>& replace) {
+    std::string data;
+    auto array = [&](const std::string& type, const std::string& name, const std::string& d) {
+      if (text_names.count(name))
+        return "<DataArray type=\"" + type + "\" Name=\"" + name + "\" format=\"ascii\">" +
+               (name == "offsets" ? "8" : "12") + "</DataArray>\n";
+      const auto it = replace.find(name);
+      const std::string& t = it == replace.end() ? type : it->second.first;
+      const std::string& bytes = it == replace.end() ? d : it->second.second;
+      const std::string offset = std::to_string(data.size());
+      data += header(bytes.size(), 8) + bytes;
+      return "<DataArray type=\"" + t + "\" Name=\"" + name + "\" format=\"appended\" offset=\"" +
+             offset + "\"/>\n";
+    };
+    std::string text = unit_cube_vtu("header_type=\"UInt64\"", array);
+    text.insert(text.rfind("</VTKFile>"),
+                "<AppendedData encoding=\"raw\">\n_" + data + "\n</AppendedData>\n");
+    const auto p = dir / file;
+    io_write_text(p, text);
+    return p.string();
+  };
+  auto raw = [](auto... values) {
+    std::string out;
+    for (auto v : {values...}) out.append(reinterpret_cast<const char*>(&v), sizeof v);
+    return out;
+  };
+  expect_unit_cube(mesh_read(write("all.vtu", {}, {})));
+  expect_unit_cube(mesh_read(write("mixed.vtu", {"offsets", "types"}, {})));
+  expect_unit_cube(mesh_read(write("mixed_types.vtu", {"types"}, {})));
+  auto refused = [&](const std::string& path, const std::string& expected) {
+    try {
+      mesh_read(path);
+      ADD_FAILURE() << path << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  const std::string wide = raw(int64_t{0}, int64_t{1}, int64_t{2}, int64_t{3}, int64_t{4},
+                               int64_t{5}, int64_t{6}, int64_t{5000000000});
+  refused(write("wide.vtu", {}, {{"connectivity", {"Int64", wide}}}),
+          "'connectivity' holds 5000000000, out of range");
+  refused(write("wide_mixed.vtu", {"types"}, {{"connectivity", {"Int64", wide}}}),
+          "'connectivity' holds 5000000000, out of range");
+  refused(write("beyond.vtu", {}, {{"connectivity", {"Int32", raw(0, 1, 2, 3, 4, 5, 6, 8)}}}),
+          "cell 0 refers to point 8, expected 0..7");
+  refused(write("huge_offset.vtu", {}, {{"offsets", {"UInt64", raw(~uint64_t{0})}}}),
+          "value 18446744073709551615 too large");
+  refused(write("tetra.vtu", {}, {{"types", {"UInt8", raw(uint8_t{10})}}}),
+          "cell 0 has VTK type 10, a volume cell that is not a linear hexahedron");
+  refused(write("two_offsets.vtu", {}, {{"offsets", {"Int64", raw(int64_t{4}, int64_t{8})}}}),
+          "Cells offsets/types need NumberOfCells = 1 values");
 }
 
 TEST(IoVtuData, TruncatedOrForeignBinaryIsRefusedWithFileAndByte) {

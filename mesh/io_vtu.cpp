@@ -455,7 +455,16 @@ HexMesh vtu_read(const std::string& path, std::string_view text, const FileBytes
             vtk_type_is_integer(legacy_type) ? static_cast<double>(v) : d;
         ++i;
       };
-      if (binary)
+      static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double));
+      if (binary && legacy_type == "double" &&
+          data.size() == static_cast<size_t>(np) * sizeof(Eigen::Vector3d)) {
+        // Float64, as the points are held: one copy, then the finiteness test.
+        std::memcpy(static_cast<void*>(st.mesh.points.data()), data.data(), data.size());
+        for (int64_t k = 0; k < np; ++k)
+          if (!st.mesh.points[k].allFinite())
+            throw InputError(path + ": point " + std::to_string(k) +
+                             " has a NaN or infinite coordinate");
+      } else if (binary)
         vtu_binary_values(path, data, legacy_type, 3 * np, "point coordinates",
                           [&](double d, int64_t v) {
                             if (!std::isfinite(d))

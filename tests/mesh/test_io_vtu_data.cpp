@@ -2,12 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <map>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "cli_runner.hpp"
 #include "io_test_support.hpp"
@@ -180,6 +182,22 @@ TEST(IoVtuData, RawCellsArraysReadInTheFileMixedWithTextAndCheckedAsDecodedOnes)
           "cell 0 has VTK type 10, a volume cell that is not a linear hexahedron");
   refused(write("two_offsets.vtu", {}, {{"offsets", {"Int64", raw(int64_t{4}, int64_t{8})}}}),
           "Cells offsets/types need NumberOfCells = 1 values");
+  // Points: Float64 copied as they are, Float32 converted; a NaN refused in both.
+  std::vector<double> points = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
+                                0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+  points[16] = std::nan("");
+  const std::vector<float> narrow(points.begin(), points.end());
+  const std::string vector_type = "\" NumberOfComponents=\"3";
+  refused(write("nan64.vtu", {},
+                {{"Points",
+                  {"Float64" + vector_type,
+                   std::string(reinterpret_cast<const char*>(points.data()), 192)}}}),
+          "point 5 has a NaN or infinite coordinate");
+  refused(write("nan32.vtu", {},
+                {{"Points",
+                  {"Float32" + vector_type,
+                   std::string(reinterpret_cast<const char*>(narrow.data()), 96)}}}),
+          "point 5 has a NaN or infinite coordinate");
 }
 
 TEST(IoVtuData, TruncatedOrForeignBinaryIsRefusedWithFileAndByte) {

@@ -46,9 +46,10 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
   // every bucket, and each range scatters its slots there. The slots of a bucket stay in hex
   // order, so the array is the same for any thread count. offsets[p][a] first counts, then holds
   // where range p's part of node a's bucket starts, and after the scatter where it ends: the last
-  // range's ends are the buckets' ends.
+  // range's ends are the buckets' ends. Each range holds a count per node, so at most four
+  // (the counts of four ranges weigh about half the hexes themselves).
   const int parts =
-      static_cast<int>(std::clamp<int64_t>(threads, 1, std::max<int64_t>(hexes / 4096, 1)));
+      static_cast<int>(std::clamp<int64_t>(threads, 1, std::clamp<int64_t>(hexes / 4096, 1, 4)));
   auto part_begin = [&](int p) { return static_cast<int32_t>(int64_t{hexes} * p / parts); };
   std::vector<std::vector<uint32_t>> offsets(static_cast<size_t>(parts));
   parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {

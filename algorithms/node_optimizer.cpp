@@ -136,7 +136,13 @@ class Optimizer {
   Optimizer(HexMesh& mesh, const NodeProblem& problem, const NodeOptimizerOptions& options)
       : mesh_(mesh), problem_(problem), options_(options) {
     quality_.resize(problem.hexes.size());
-    for (size_t k = 0; k < problem.hexes.size(); ++k) quality_[k] = hex_quality(k);
+    for (size_t k = 0; k < problem.hexes.size(); k += 2) {  // two hexes per evaluation
+      const size_t other = std::min(k + 1, problem.hexes.size() - 1);
+      const std::array<double, 2> pair = hex_scaled_jacobian_pair(
+          hex_points(mesh, problem.hexes[k]), hex_points(mesh, problem.hexes[other]));
+      quality_[k] = pair[0];
+      quality_[other] = pair[1];
+    }
     state_.resize(problem.nodes.size());
     start_.resize(problem.nodes.size());
     size_t valence = 0;
@@ -199,10 +205,6 @@ class Optimizer {
   }
 
  private:
-  double hex_quality(size_t k) const {
-    return hex_scaled_jacobian(hex_points(mesh_, problem_.hexes[k]));
-  }
-
   // --- slides ------------------------------------------------------------------------------
 
   const NodeSlide& slide(int32_t i) const { return problem_.slides[i]; }
@@ -585,6 +587,8 @@ NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
       std::fill(next_active.begin(), next_active.end(), 0);
       double largest_relative_move = 0;
       for (int32_t i : order) {
+        // A node visit() would leave (its worst hex at or above visit_below) costs no scale.
+        if (!(optimizer.local_min(i) < options.visit_below)) continue;
         const double h = optimizer.scale(i);
         const double moved = optimizer.visit(i);
         if (!(moved > 0)) continue;

@@ -76,8 +76,8 @@ Lanes lanes_determinant(const LaneVector& a, const LaneVector& b, const LaneVect
          c.x * (a.y * b.z - b.y * a.z);
 }
 
-/// scaled_determinant lane by lane: clamp(det / (l0 l1 l2), -1, 1), 0 where the product of the
-/// lengths is not above the smallest normal double.
+/// One scaled-Jacobian sample lane by lane: clamp(det / (l0 l1 l2), -1, 1) for the columns a, b,
+/// c of lengths l0, l1, l2; 0 where l0 l1 l2 is not above the smallest normal double.
 Lanes lanes_scaled_determinant(const LaneVector& a, const LaneVector& b, const LaneVector& c,
                                Lanes length0, Lanes length1, Lanes length2) {
   const Lanes lengths = length0 * length1 * length2;

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <new>
 #include <sstream>
+#include <thread>
 
 #include "mesh/error.hpp"
 
@@ -177,6 +178,11 @@ long long cli_parse_int_in(const std::string& text, long long lo, long long hi,
     throw InputError(what + " must be in " + std::to_string(lo) + ".." + std::to_string(hi) +
                      ", got '" + text + "'");
   return v;
+}
+
+int cli_threads(const std::optional<std::string>& value) {
+  if (value) return static_cast<int>(cli_parse_int_in(*value, 1, 256, "--threads"));
+  return static_cast<int>(std::clamp<unsigned>(std::thread::hardware_concurrency(), 1, 256));
 }
 
 std::vector<double> cli_parse_doubles(const std::string& text, int count, const std::string& what) {

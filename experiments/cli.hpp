@@ -70,6 +70,10 @@ long long cli_parse_int(const std::string& text, const std::string& what);
 long long cli_parse_int_in(const std::string& text, long long lo, long long hi,
                            const std::string& what);
 
+/// The thread count of --threads: the value given (1..256), else every core the system reports
+/// (at most 256, at least 1). The output does not depend on it (parallel.hpp), only the time.
+int cli_threads(const std::optional<std::string>& value);
+
 int cli_main(int argc, char** argv);
 
 // The commands (each defined in its cli_*.cpp).

@@ -42,10 +42,7 @@ int check_run(const CliArgs& a) {
         "hexrefine check: expected exactly one MESH argument (usage: hexrefine check "
         "MESH [--reference REF] [--report R.json])");
   const std::string path = a.positional[0];
-  const int threads =
-      a.value("--threads")
-          ? static_cast<int>(cli_parse_int_in(*a.value("--threads"), 1, 256, "--threads"))
-          : 1;
+  const int threads = cli_threads(a.value("--threads"));
   std::ostream* verbose = a.flag("--verbose") ? &std::cerr : nullptr;
   nlohmann::json stage_seconds = nlohmann::json::object();
   auto start = std::chrono::steady_clock::now();
@@ -131,7 +128,7 @@ const CliCommand cli_check_command = {
          "the mesh before refinement: compare boundary, volume and area with it"},
         {"--report", "R.json", "write the JSON report"},
         {"--sheets", "", "also count the dual sheets (builds the full topology: slower)"},
-        {"--threads", "N", "threads for the check, 1..256 (same report)"},
+        {"--threads", "N", "threads for the check, 1..256 (same report; default: every core)"},
         {"--verbose", "", "print each stage's time on stderr as it ends"},
     },
     "exit codes: 0 valid, 1 defects found (the report is still written), 2 bad usage or input\n",

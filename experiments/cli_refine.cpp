@@ -66,8 +66,7 @@ int refine_run(const CliArgs& a) {
   o.refine.propagation = !a.flag("--no-propagation");
   o.refine.ebe_only = a.flag("--ebe-only");
   o.refine.allow_inverted = a.flag("--allow-inverted");
-  if (const auto t = a.value("--threads"))
-    o.refine.threads = static_cast<int>(cli_parse_int_in(*t, 1, 256, "--threads"));
+  o.refine.threads = cli_threads(a.value("--threads"));
   if (const auto p = a.value("--placement")) {
     if (*p == "trilinear")
       o.refine.placement.method = PlacementMethod::trilinear;
@@ -151,7 +150,8 @@ const CliCommand cli_refine_command = {
         {"--ascii", "", "VTU output as text instead of appended binary data (.vtu only)"},
         {"--compress", "", "VTU output zlib-compressed (.vtu only)"},
         {"--threads", "N",
-         "threads for the template application and the check, 1..256 (same output)"},
+         "threads for the template application and the check, 1..256 (same output; default: "
+         "every core)"},
         {"--report", "R.json", "write the JSON report (stats, checks, stage times)"},
         {"--verbose", "", "print each stage's time on stderr as it ends"},
     },

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <thread>
 
 #include "mesh/error.hpp"
 #include "tests/cli_runner.hpp"
@@ -47,6 +49,15 @@ TEST(Cli, ParsesNumberLists) {
   EXPECT_DOUBLE_EQ(cli_parse_doubles("0.5,1e-3", -1, "x")[1], 1e-3);
   EXPECT_EQ(cli_parse_int_in("7", 1, 10, "--passes"), 7);
   EXPECT_THROW(cli_parse_int_in("11", 1, 10, "--passes"), InputError);
+}
+
+TEST(Cli, ThreadsDefaultToEveryCoreAndTakeOnly1To256) {
+  const unsigned cores = std::thread::hardware_concurrency();
+  EXPECT_EQ(cli_threads(std::nullopt), static_cast<int>(std::clamp<unsigned>(cores, 1, 256)));
+  EXPECT_EQ(cli_threads(std::string("3")), 3);
+  EXPECT_EQ(cli_threads(std::string("256")), 256);
+  for (const char* bad : {"0", "257", "two"})
+    EXPECT_THROW(cli_threads(std::string(bad)), InputError);
 }
 
 TEST(Cli, EveryCommandExplainsItselfAndTheUsageListsEveryOption) {

@@ -136,13 +136,7 @@ class Optimizer {
   Optimizer(HexMesh& mesh, const NodeProblem& problem, const NodeOptimizerOptions& options)
       : mesh_(mesh), problem_(problem), options_(options) {
     quality_.resize(problem.hexes.size());
-    for (size_t k = 0; k < problem.hexes.size(); k += 2) {  // two hexes per evaluation
-      const size_t other = std::min(k + 1, problem.hexes.size() - 1);
-      const std::array<double, 2> pair = hex_scaled_jacobian_pair(
-          hex_points(mesh, problem.hexes[k]), hex_points(mesh, problem.hexes[other]));
-      quality_[k] = pair[0];
-      quality_[other] = pair[1];
-    }
+    mesh_scaled_jacobians(mesh, problem.hexes, quality_);
     state_.resize(problem.nodes.size());
     start_.resize(problem.nodes.size());
     size_t valence = 0;

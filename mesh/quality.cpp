@@ -225,23 +225,37 @@ double hex_volume(const HexCorners& p) {
          12.0;
 }
 
-void mesh_scaled_jacobians(const HexMesh& mesh, int32_t first, std::span<double> out) {
-  const int32_t count = static_cast<int32_t>(out.size());
-  auto corners = [&](int32_t h) {
+namespace {
+
+/// out[k] = hex_scaled_jacobian of hex hex_of(k), k < out.size(), two hexes per evaluation.
+template <class HexOf>
+void scaled_jacobians_in_pairs(const HexMesh& mesh, HexOf hex_of, std::span<double> out) {
+  const size_t count = out.size();
+  for (size_t k = 0; k < count; k += 2) {
+    const HexCell& a = mesh.hexes[hex_of(k)];
+    const HexCell& b = mesh.hexes[hex_of(std::min(k + 1, count - 1))];
     std::array<LaneVector, 8> p;
-    const HexCell& a = mesh.hexes[first + h];
-    const HexCell& b = mesh.hexes[first + std::min(h + 1, count - 1)];
     for (int v = 0; v < 8; ++v) {
       const Eigen::Vector3d &x = mesh.points[a[v]], &y = mesh.points[b[v]];
       p[v] = {Lanes{x[0], y[0]}, Lanes{x[1], y[1]}, Lanes{x[2], y[2]}};
     }
-    return p;
-  };
-  for (int32_t h = 0; h < count; h += 2) {
-    const Lanes pair = lanes_scaled_jacobian(corners(h));
-    out[h] = pair[0];
-    if (h + 1 < count) out[h + 1] = pair[1];
+    const Lanes pair = lanes_scaled_jacobian(p);
+    out[k] = pair[0];
+    if (k + 1 < count) out[k + 1] = pair[1];
   }
+}
+
+}  // namespace
+
+void mesh_scaled_jacobians(const HexMesh& mesh, int32_t first, std::span<double> out) {
+  scaled_jacobians_in_pairs(
+      mesh, [&](size_t k) { return first + static_cast<int32_t>(k); }, out);
+}
+
+void mesh_scaled_jacobians(const HexMesh& mesh, std::span<const int32_t> hexes,
+                           std::span<double> out) {
+  scaled_jacobians_in_pairs(
+      mesh, [&](size_t k) { return hexes[k]; }, out);
 }
 
 std::vector<double> mesh_scaled_jacobians(const HexMesh& mesh) {

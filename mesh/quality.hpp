@@ -105,6 +105,11 @@ std::vector<double> mesh_scaled_jacobians(const HexMesh& mesh);
 /// passes). Precondition: mesh_validate_ids holds and the hexes exist.
 void mesh_scaled_jacobians(const HexMesh& mesh, int32_t first, std::span<double> out);
 
+/// The same for the listed hexes: out[k] = hex_scaled_jacobian of hex hexes[k] (out.size() ==
+/// hexes.size()), bit-identical to calling it hex by hex.
+void mesh_scaled_jacobians(const HexMesh& mesh, std::span<const int32_t> hexes,
+                           std::span<double> out);
+
 /// Minimum hex_scaled_jacobian over the mesh; 1 (a perfect hex) for an empty mesh so reports stay
 /// finite. Precondition: mesh_validate_ids holds.
 double mesh_min_scaled_jacobian(const HexMesh& mesh);

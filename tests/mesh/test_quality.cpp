@@ -187,6 +187,14 @@ TEST(Quality, MeshScaledJacobiansOfAnyRangeMatchEachHex) {
       for (int32_t k = 0; k < count; ++k)
         ASSERT_EQ(out[k], hex_scaled_jacobian(hex_points(m, first + k))) << first << " " << k;
     }
+  // A list of hexes in any order, repeats allowed, odd or even length.
+  const std::vector<int32_t> ids = {6, 0, 3, 3, 5};
+  for (size_t count = 0; count <= ids.size(); ++count) {
+    std::vector<double> out(count, -2.0);
+    mesh_scaled_jacobians(m, std::span<const int32_t>(ids.data(), count), out);
+    for (size_t k = 0; k < count; ++k)
+      ASSERT_EQ(out[k], hex_scaled_jacobian(hex_points(m, ids[k]))) << count << " " << k;
+  }
 }
 
 TEST(Quality, VolumeIsTheGaussIntegralOfTheJacobian) {

@@ -13,6 +13,7 @@
 #include "mesh/error.hpp"
 #include "mesh/quality.hpp"
 #include "mesh/selection.hpp"
+#include "mesh/staged_write.hpp"
 
 namespace hexrefine {
 
@@ -126,7 +127,12 @@ double process_peak_memory_mb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KB on Linux
 }
 
-PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
+namespace {
+
+/// pipeline_run, and with a non-empty `out` the write of the final mesh there (see
+/// pipeline_run_files).
+PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions& o,
+                                    const std::string& out) {
   const auto start = Clock::now();
   PipelineResult r;
   StageClock clock(r, o.verbose, o.progress);
@@ -195,34 +201,69 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
     return m;
   };
 
-  r.check = mesh_check(r.mesh, &input, o.refine.threads);
-  r.children_min_scaled_jacobian = children_min(r.check);
-  clock.end("check");
-  verdict_enforce(r.check, r.mesh, input, o, r.ablation, "the " + o.method + " refiner");
-
-  if (o.smooth) {
-    SmoothOptions so = o.smoothing;
-    so.region_hexes = mesh_refined_hexes(r.mesh);
-    if (!so.region_hexes.empty()) {
-      // Boundary nodes the refinement made slide within the input face or edge they subdivide,
-      // the input's boundary nodes stay: the smoothed mesh is checked against the input again.
-      const BoundaryReference reference =
-          boundary_reference_build(input, topology_build(input, TopologyParts::faces));
-      so.reference = &reference;
-      so.reference_nodes = input.point_count();
-      clock.begin("smooth");
-      r.smoothing = mesh_smooth(r.mesh, so);
-      clock.end("smooth");
-      clock.begin("check (smoothed)");
-      r.smoothed_check = mesh_check(r.mesh, &input, o.refine.threads);
-      r.smoothed_children_min_scaled_jacobian = children_min(*r.smoothed_check);
-      clock.end("check_smoothed");
-      verdict_enforce(*r.smoothed_check, r.mesh, input, o, r.ablation, "smoothing");
+  // The final mesh is the smoothed one when there is a refined region to smooth.
+  std::vector<int32_t> smooth_region;
+  if (o.smooth) smooth_region = mesh_refined_hexes(r.mesh);
+  // Checks the mesh; the check of the final mesh runs beside its write to `out` when there is
+  // more than one thread (the writer takes a thread of its own; one thread: one after the
+  // other). The written file becomes `out` only once the verdict allows it.
+  auto check_and_write = [&](const std::string& stage, MeshCheckReport& check,
+                             double& children_min_scaled_jacobian, bool final_mesh,
+                             const std::string& what) {
+    std::optional<StagedMeshWrite> staged;
+    if (final_mesh && !out.empty() && o.refine.threads > 1) {
+      clock.begin(stage + " and write");
+      staged.emplace(out, r.mesh, o.write);
     }
+    check = mesh_check(r.mesh, &input, o.refine.threads);
+    children_min_scaled_jacobian = children_min(check);
+    const double writer_cpu = staged ? staged->cpu_seconds_so_far() : 0.0;
+    clock.end(stage);
+    r.stage_cpu_seconds[stage] -= writer_cpu;  // the writer's thread is the write stage's
+    verdict_enforce(check, r.mesh, input, o, r.ablation, what);
+    if (final_mesh && !out.empty()) {
+      if (!staged) {
+        clock.begin("write");
+        staged.emplace(out, r.mesh, o.write);
+      }
+      staged->commit();
+      r.stage_seconds["write"] = staged->seconds();
+      r.stage_cpu_seconds["write"] = staged->cpu_seconds();
+      if (o.verbose)
+        *o.verbose << "hexrefine: write " << std::fixed << std::setprecision(3) << staged->seconds()
+                   << " s" << (o.refine.threads > 1 ? " (beside the check)" : "") << std::endl;
+    }
+  };
+
+  check_and_write("check", r.check, r.children_min_scaled_jacobian, smooth_region.empty(),
+                  "the " + o.method + " refiner");
+  if (!smooth_region.empty()) {
+    SmoothOptions so = o.smoothing;
+    so.region_hexes = std::move(smooth_region);
+    // Boundary nodes the refinement made slide within the input face or edge they subdivide,
+    // the input's boundary nodes stay: the smoothed mesh is checked against the input again.
+    const BoundaryReference reference =
+        boundary_reference_build(input, topology_build(input, TopologyParts::faces));
+    so.reference = &reference;
+    so.reference_nodes = input.point_count();
+    clock.begin("smooth");
+    r.smoothing = mesh_smooth(r.mesh, so);
+    clock.end("smooth");
+    clock.begin("check (smoothed)");
+    r.smoothed_check.emplace();
+    r.smoothed_children_min_scaled_jacobian.emplace();
+    check_and_write("check_smoothed", *r.smoothed_check, *r.smoothed_children_min_scaled_jacobian,
+                    true, "smoothing");
   }
   r.stage_seconds["total"] = seconds_since(start);
   r.peak_memory_mb = process_peak_memory_mb();
   return r;
+}
+
+}  // namespace
+
+PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& o) {
+  return pipeline_run_writing(input, o, "");
 }
 
 PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
@@ -235,15 +276,9 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
   clock.end("read");
   PipelineResult r;
   try {
-    r = pipeline_run(input, options);
+    r = pipeline_run_writing(input, options, out);
   } catch (const InputError& e) {
     throw InputError(in + ": " + e.what());  // the input, or a spec applied to it
-  }
-  if (!out.empty()) {
-    StageClock write_clock(r, options.verbose, options.progress);
-    write_clock.begin("write");
-    mesh_write(out, r.mesh, options.write);
-    write_clock.end("write");
   }
   r.stage_seconds["read"] = scratch.stage_seconds["read"];
   r.stage_cpu_seconds["read"] = scratch.stage_cpu_seconds["read"];

@@ -101,7 +101,11 @@ struct PipelineResult {
 PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& options);
 
 /// read `in` -> pipeline_run -> write `out` (atomically; not written when the pipeline throws).
-/// `out` may be empty (nothing written). Adds the read and write stages.
+/// `out` may be empty (nothing written). Adds the read and write stages. With more than one
+/// thread (options.refine.threads) the final mesh is written beside its check, on a thread of
+/// its own (mesh/staged_write.hpp): the file becomes `out` only once the verdict allows it, so
+/// the result is the same as writing after the check, and the two stages' times overlap
+/// ("write" is the writer thread's wall and CPU time; "check" leaves that thread's CPU out).
 PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
                                   const PipelineOptions& options);
 

@@ -11,15 +11,36 @@
 
 namespace hexrefine {
 
-std::string file_temporary_beside(const std::string& path) {
+namespace {
+
+/// "<pid>.<n>": unique among the files this process names.
+std::string process_unique_tag() {
   static std::atomic<int> counter{0};
+  std::string tag = std::to_string(::getpid());
+  tag += ".";
+  tag += std::to_string(counter++);
+  return tag;
+}
+
+}  // namespace
+
+// The names are built by appending: GCC 12 warns (-Wrestrict, a false positive) on
+// "literal" + std::string here.
+std::string file_temporary_beside(const std::string& path) {
   const std::filesystem::path p(path);
   std::string name = ".";
   name += p.filename().string();
   name += ".tmp";
-  name += std::to_string(::getpid());
+  name += process_unique_tag();
+  return (p.parent_path() / name).string();
+}
+
+std::string file_staging_beside(const std::string& path) {
+  const std::filesystem::path p(path);
+  std::string name = ".staged";
+  name += process_unique_tag();
   name += ".";
-  name += std::to_string(counter++);
+  name += p.filename().string();
   return (p.parent_path() / name).string();
 }
 

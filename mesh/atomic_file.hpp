@@ -20,6 +20,11 @@ void file_write_atomically(const std::string& path,
 /// pair with file_commit_temporary.
 std::string file_temporary_beside(const std::string& path);
 
+/// A staging path beside `path` that keeps its file name, hence its extension and format:
+/// "dir/.staged<pid>.<n>.name.ext" (hidden, unique in this process). Pair with
+/// file_commit_temporary.
+std::string file_staging_beside(const std::string& path);
+
 /// Renames `temporary` to `path` (throws OperationError and removes `temporary` on failure).
 void file_commit_temporary(const std::string& temporary, const std::string& path);
 

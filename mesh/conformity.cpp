@@ -318,19 +318,23 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
     r.unused_nodes = std::count(used.begin(), used.end(), 0);
   }
   r.duplicate_nodes = count_duplicate_nodes(mesh, threads);
-  HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, threads);
+  // Doublets come from the matching itself: no neighbour array (24 bytes per hex) is built.
+  HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, threads, false);
   r.nonmanifold_faces = static_cast<int64_t>(adjacency.nonmanifold_faces.size());
 
   // Hexes with a defect: every source offers its lowest mesh_check_defect_hex_limit, so the
   // report lists the lowest overall.
   std::vector<int32_t> defects;
   for (const HexFaceSlot& f : adjacency.nonmanifold_faces) defects.push_back(f.hex);
+  r.doublets = static_cast<int64_t>(adjacency.doublets.size());
+  defects.insert(defects.end(), adjacency.doublets.begin(),
+                 adjacency.doublets.begin() +
+                     std::min(adjacency.doublets.size(), mesh_check_defect_hex_limit));
 
-  // Quality, volume and doublets (a neighbour met across two local faces of the same hex), per
-  // fixed chunk of hexes so the sums do not depend on the thread count.
+  // Quality and volume, per fixed chunk of hexes so the sums do not depend on the thread count.
   struct ChunkSums {
     double scaled_jacobian_sum = 0.0, volume = 0.0, min_scaled_jacobian = 1.0;
-    int64_t inverted = 0, doublets = 0;
+    int64_t inverted = 0;
     std::array<int64_t, 20> histogram{};
     std::vector<int32_t> defects;  // ascending, at most the limit per kind
   };
@@ -338,7 +342,6 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   std::vector<ChunkSums> sums(static_cast<size_t>(parallel_chunk_count(r.hexes, chunk_hexes)));
   parallel_chunks(threads, r.hexes, chunk_hexes, [&](int64_t chunk, int64_t begin, int64_t end) {
     ChunkSums& s = sums[chunk];
-    size_t doublet_defects = 0;
     std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin));
     mesh_scaled_jacobians(mesh, static_cast<int32_t>(begin), scaled_jacobians);
     for (int32_t h = static_cast<int32_t>(begin); h < end; ++h) {
@@ -349,18 +352,6 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
       ++s.histogram[scaled_jacobian_bin(sj)];
       if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
         s.defects.push_back(h);
-      const std::array<int32_t, 6>& neighbours = adjacency.hex_neighbors[h];
-      for (int f = 0; f < 6; ++f) {
-        const int32_t g = neighbours[f];
-        if (g <= h) continue;  // count each pair once, from its lower hex
-        bool seen_before = false, repeated = false;
-        for (int e = 0; e < 6; ++e)
-          if (e != f && neighbours[e] == g) (e < f ? seen_before : repeated) = true;
-        if (repeated && !seen_before) {
-          ++s.doublets;
-          if (doublet_defects++ < mesh_check_defect_hex_limit) s.defects.push_back(h);
-        }
-      }
     }
   });
   double sum_scaled_jacobian = 0.0;
@@ -371,13 +362,11 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
     r.min_scaled_jacobian = std::min(r.min_scaled_jacobian, s.min_scaled_jacobian);
     if (s.inverted > 0 && r.inverted_hexes == 0) r.first_inverted_hex = s.defects.front();
     r.inverted_hexes += s.inverted;
-    r.doublets += s.doublets;
     for (int b = 0; b < 20; ++b) r.scaled_jacobian_histogram[b] += s.histogram[b];
     defects.insert(defects.end(), s.defects.begin(), s.defects.end());
   }
   sums.clear();
   if (r.hexes > 0) r.mean_scaled_jacobian = sum_scaled_jacobian / static_cast<double>(r.hexes);
-  std::vector<std::array<int32_t, 6>>().swap(adjacency.hex_neighbors);
 
   // Boundary surface: closedness and area.
   const BoundarySurface surface = boundary_surface(mesh, std::move(adjacency.boundary_faces));

@@ -31,6 +31,38 @@ std::array<int32_t, 3> face_other_nodes(const HexCell& c, int lf, int32_t lowest
   return o;
 }
 
+/// The sorted node set of local face lf of c.
+std::array<int32_t, 4> face_node_set(const HexCell& c, int lf) {
+  std::array<int32_t, 4> q{};
+  for (int i = 0; i < 4; ++i) q[i] = c[hex_faces[lf][i]];
+  std::sort(q.begin(), q.end());
+  return q;
+}
+
+/// Whether hexes a and b, which share their local faces la and lb (as node sets), form a doublet
+/// counted at that face: they share another face too, and la is the lowest local face of a that
+/// they share. A second shared face holds two nodes of each hex outside the first (an edge of
+/// it, or all four when it is the opposite face), so the hexes' faces opposite la and lb have a
+/// node in common; that test, 16 comparisons, settles almost every face.
+bool faces_make_doublet(const HexCell& a, int la, const HexCell& b, int lb) {
+  const int* oa = hex_faces[hex_opposite_face[la]];
+  const int* ob = hex_faces[hex_opposite_face[lb]];
+  bool common = false;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) common |= a[oa[i]] == b[ob[j]];
+  if (!common) return false;
+  std::array<std::array<int32_t, 4>, 6> faces_b;
+  for (int f = 0; f < 6; ++f) faces_b[f] = face_node_set(b, f);
+  int lowest_shared = -1, shared = 0;
+  for (int f = 0; f < 6; ++f) {
+    const std::array<int32_t, 4> q = face_node_set(a, f);
+    if (std::find(faces_b.begin(), faces_b.end(), q) == faces_b.end()) continue;
+    if (lowest_shared < 0) lowest_shared = f;
+    ++shared;
+  }
+  return shared >= 2 && lowest_shared == la;
+}
+
 }  // namespace
 
 HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool neighbors) {
@@ -84,6 +116,7 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
   const int64_t chunks = parallel_chunk_count(nodes, chunk_nodes);
   std::vector<std::vector<HexFaceSlot>> boundary(static_cast<size_t>(chunks));
   std::vector<std::vector<HexFaceSlot>> nonmanifold(static_cast<size_t>(chunks));
+  std::vector<std::vector<int32_t>> doublets(static_cast<size_t>(chunks));
   parallel_chunks(threads, nodes, chunk_nodes, [&](int64_t chunk, int64_t begin, int64_t end) {
     struct SlotKey {
       std::array<int32_t, 3> others;
@@ -114,6 +147,7 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
         if (keys[i].matched) continue;
         const int32_t h0 = static_cast<int32_t>(keys[i].slot / 6);
         int32_t h1 = -1, users = 1;
+        uint32_t second_slot = 0;
         for (size_t j = i + 1; j < keys.size(); ++j) {
           if (keys[j].matched || keys[j].others[0] != keys[i].others[0] ||
               keys[j].others[1] != keys[i].others[1] || keys[j].others[2] != keys[i].others[2])
@@ -121,9 +155,16 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
           keys[j].matched = true;
           const int32_t h = static_cast<int32_t>(keys[j].slot / 6);
           if (neighbors) a.hex_neighbors[h][keys[j].slot % 6] = h0;
-          if (++users == 2) h1 = h;
+          if (++users == 2) {
+            h1 = h;
+            second_slot = keys[j].slot;
+          }
         }
         if (neighbors) a.hex_neighbors[h0][keys[i].slot % 6] = h1;
+        if (h1 >= 0 && h1 != h0 &&
+            faces_make_doublet(mesh.hexes[h0], static_cast<int>(keys[i].slot % 6), mesh.hexes[h1],
+                               static_cast<int>(second_slot % 6)))
+          doublets[chunk].push_back(h0);
         if (users == 1)
           boundary[chunk].push_back({h0, static_cast<int32_t>(keys[i].slot % 6)});
         else if (users > 2)
@@ -136,7 +177,9 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
     a.boundary_faces.insert(a.boundary_faces.end(), boundary[c].begin(), boundary[c].end());
     a.nonmanifold_faces.insert(a.nonmanifold_faces.end(), nonmanifold[c].begin(),
                                nonmanifold[c].end());
+    a.doublets.insert(a.doublets.end(), doublets[c].begin(), doublets[c].end());
   }
+  std::sort(a.doublets.begin(), a.doublets.end());
   return a;
 }
 

@@ -1,11 +1,12 @@
 #pragma once
 /// \file
 /// Face adjacency of a hex mesh without the general topology: which hex lies across each local
-/// face, the boundary faces and the non-manifold faces, from one counting sort of the 6 n face
-/// slots (hex, local face) by their lowest node and a match of the remaining three nodes within
-/// each node's slots. No face ids, face node arrays or node -> hex lists are built, so checking
-/// an 11 M-hex output needs 28 bytes per hex here (the slots, the neighbours and the bucket
-/// offsets) instead of the ~150 of topology_build.
+/// face, the boundary faces, the non-manifold faces and the doublets, from one counting sort of
+/// the 6 n face slots (hex, local face) by their lowest node and a match of the remaining three
+/// nodes within each node's slots. No face ids, face node arrays or node -> hex lists are built:
+/// 24 bytes per hex (the slots) and 4 per node and thread (the bucket counts, at most four),
+/// plus 24 per hex for the neighbour array when it is asked for (the checker does not), instead
+/// of the ~150 of topology_build.
 ///
 /// Two slots are the same face when their four nodes are the same set (as in topology_build).
 
@@ -33,6 +34,11 @@ struct HexFaceAdjacency {
   std::vector<HexFaceSlot> boundary_faces;
   /// Each face used by more than two hexes, as its lowest hex's slot, in the same face order.
   std::vector<HexFaceSlot> nonmanifold_faces;
+  /// Doublets: pairs of hexes that share two or more faces (as node sets), each pair once as its
+  /// lower hex, ascending. Found while matching, from the two lowest users of each face, so no
+  /// neighbour array is needed; on faces with more than two users (non-manifold, an invalid mesh
+  /// anyway) the other users are not paired.
+  std::vector<int32_t> doublets;
 };
 
 /// Most hexes hex_face_adjacency_build accepts: its slot ids h * 6 + lf are 32-bit.

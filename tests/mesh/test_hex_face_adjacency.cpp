@@ -30,6 +30,44 @@ void expect_same_as_topology(const HexMesh& m, const HexFaceAdjacency& a) {
     EXPECT_EQ(t.hex_face_ids[s.hex][s.local_face], t.nonmanifold_faces[i]);
     EXPECT_EQ(t.face_hexes[t.nonmanifold_faces[i]][0], s.hex);  // the lowest user
   }
+  // Doublets: on a manifold mesh, the hexes h with a higher neighbour across two or more of
+  // their faces (the neighbour array's definition, which the checker used before).
+  if (!t.nonmanifold_faces.empty()) return;
+  std::vector<int32_t> doublets;
+  for (int32_t h = 0; h < m.hex_count(); ++h)
+    for (int f = 0; f < 6; ++f) {
+      const int32_t g = hex_face_neighbor(t, h, f);
+      if (g <= h) continue;
+      int uses = 0, first = -1;
+      for (int e = 0; e < 6; ++e)
+        if (hex_face_neighbor(t, h, e) == g) uses += 1, first = first < 0 ? e : first;
+      if (uses >= 2 && first == f) doublets.push_back(h);
+    }
+  EXPECT_EQ(a.doublets, doublets);
+}
+
+/// `copies` disjoint unit cubes, each with a second hex sharing two of its faces (a doublet),
+/// the hexes in a shuffled order so that pairs span the matching's node chunks.
+HexMesh doublets_fixture(int copies) {
+  HexMesh m;
+  std::vector<HexCell> hexes;
+  for (int k = 0; k < copies; ++k) {
+    const HexMesh cube = fixture_brick(1, 1, 1);
+    const int32_t o = m.point_count();
+    for (const Eigen::Vector3d& p : cube.points)
+      m.points.push_back(p + Eigen::Vector3d(3.0 * k, 0, 0));
+    m.points.emplace_back(3.0 * k - 1, -1, 0);
+    m.points.emplace_back(3.0 * k - 1, -1, 1);
+    HexCell c = cube.hexes[0];
+    for (int32_t& v : c) v += o;
+    hexes.push_back(c);
+    // Shares the cube's +x face {1,3,7,5} and +y face {2,6,7,3} (node ids of the cube).
+    hexes.push_back({o + 3, o + 2, o + 8, o + 1, o + 7, o + 6, o + 9, o + 5});
+  }
+  // A fixed shuffle: hex i goes to (i * 7919) mod n (7919 is prime, n even and not a multiple).
+  m.hexes.resize(hexes.size());
+  for (size_t i = 0; i < hexes.size(); ++i) m.hexes[i * 7919 % hexes.size()] = hexes[i];
+  return m;
 }
 
 TEST(HexFaceAdjacency, BrickCounts) {
@@ -66,6 +104,25 @@ TEST(HexFaceAdjacency, NonManifoldFaceGoesToItsLowestHex) {
   for (int32_t g : a.hex_neighbors[2]) to_hex0 += g == 0;
   EXPECT_EQ(to_hex0, 6);
   expect_same_as_topology(m, a);
+  // Hexes 0 and 2 share all six faces, five of them with no third user: one doublet, as hex 0.
+  EXPECT_EQ(a.doublets, std::vector<int32_t>{0});
+}
+
+TEST(HexFaceAdjacency, DoubletsFoundWhileMatchingOnAnyThreadCount) {
+  const int copies = 9000;  // 90,000 nodes: the matching's node chunks hold 32,768
+  const HexMesh m = doublets_fixture(copies);
+  const HexFaceAdjacency one = hex_face_adjacency_build(m, 1);
+  ASSERT_EQ(one.doublets.size(), static_cast<size_t>(copies));
+  EXPECT_TRUE(std::is_sorted(one.doublets.begin(), one.doublets.end()));
+  expect_same_as_topology(m, one);
+  EXPECT_EQ(hex_face_adjacency_build(m, 2, false).doublets, one.doublets);
+  // The lower hex of each pair: both hexes of copy k sit at 2k * 7919 and (2k + 1) * 7919 mod n.
+  const size_t n = m.hexes.size();
+  std::vector<int32_t> lower;
+  for (size_t k = 0; k < static_cast<size_t>(copies); ++k)
+    lower.push_back(static_cast<int32_t>(std::min(2 * k * 7919 % n, (2 * k + 1) * 7919 % n)));
+  std::sort(lower.begin(), lower.end());
+  EXPECT_EQ(one.doublets, lower);
 }
 
 TEST(HexFaceAdjacency, SharedMeshesMatchTopologyOnAnyThreadCount) {
@@ -76,6 +133,7 @@ TEST(HexFaceAdjacency, SharedMeshesMatchTopologyOnAnyThreadCount) {
     expect_same_as_topology(m, one);
     const HexFaceAdjacency two = hex_face_adjacency_build(m, 2);
     EXPECT_EQ(two.hex_neighbors, one.hex_neighbors);
+    EXPECT_EQ(two.doublets, one.doublets);
     ASSERT_EQ(two.boundary_faces.size(), one.boundary_faces.size());
     for (size_t i = 0; i < one.boundary_faces.size(); ++i) {
       EXPECT_EQ(two.boundary_faces[i].hex, one.boundary_faces[i].hex);

@@ -44,6 +44,8 @@ class QuadGrid {
     cell_ = std::max({diameter_sum / static_cast<double>(quads.size()), extent / double(1 << 19),
                       std::numeric_limits<double>::min() * 1e10});
     std::vector<int32_t> counts;
+    box_lo_.resize(quads.size());
+    box_hi_.resize(quads.size());
     for (int pass = 0; pass < 2; ++pass) {
       for (size_t i = 0; i < quads.size(); ++i) {
         Eigen::Vector3d qlo = quads[i][0], qhi = quads[i][0];
@@ -52,6 +54,12 @@ class QuadGrid {
           qhi = qhi.cwiseMax(c);
         }
         const Eigen::Vector3d grow = Eigen::Vector3d::Constant(tolerances[i]);
+        // find()'s box test: a little wider than the tolerance, so that rounding in
+        // quad_distance never makes it refuse a quad the distance would accept.
+        const Eigen::Vector3d margin =
+            grow + Eigen::Vector3d::Constant(1e-9 * (tolerances[i] + (qhi - qlo).maxCoeff()));
+        box_lo_[i] = qlo - margin;
+        box_hi_[i] = qhi + margin;
         const auto a = cell_of(qlo - grow), b = cell_of(qhi + grow);
         for (int64_t z = a[2]; z <= b[2]; ++z)
           for (int64_t y = a[1]; y <= b[1]; ++y)
@@ -97,6 +105,10 @@ class QuadGrid {
     if (it == bucket_of_cell_.end()) return false;
     for (int32_t k = offsets_[it->second]; k < offsets_[it->second + 1]; ++k) {
       const int32_t i = items_[k];
+      // The patch lies in its corners' box: a point outside the box grown by the tolerance is
+      // farther than the tolerance, and most quads of a cell are rejected without projecting.
+      if ((p.array() < box_lo_[i].array()).any() || (p.array() > box_hi_[i].array()).any())
+        continue;
       if (quad_distance(quads_[i], p) <= tolerances_[i] && visit(i)) return true;
     }
     return false;
@@ -123,6 +135,7 @@ class QuadGrid {
   double cell_ = 1.0;
   std::unordered_map<uint64_t, int32_t> bucket_of_cell_;
   std::vector<int32_t> offsets_, items_, fill_;
+  std::vector<Eigen::Vector3d> box_lo_, box_hi_;  // per quad: its corners' box, grown
 };
 
 /// Boundary surface of a mesh: its boundary face slots, their node ids (outward from their hex)

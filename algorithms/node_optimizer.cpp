@@ -37,15 +37,23 @@
 /// sweep; they stop after max_sweeps, when no node is active, or when a sweep moved no node by
 /// more than 1e-7 of its local edge length or improved neither the minimum (by 1e-9) nor the
 /// mean (by 1e-6).
+/// Threads: a sweep is cut into levels of its worst-first order (a node one level above the
+/// highest earlier node it shares a hex with; the level scheduling of a sparse triangular solve
+/// applied to Gauss-Seidel). A visit reads and writes only its node and what lies in the hexes
+/// around it, so visiting level by level replays the serial sweep exactly, and the nodes of one
+/// level, which share no hex, are visited by several workers (each with its own scratch) at
+/// once. Output is bit-identical for any thread count and to the serial sweep.
 
 #include "algorithms/node_optimizer.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
 #include "mesh/hex_convention.hpp"
+#include "mesh/parallel.hpp"
 #include "mesh/quality.hpp"
 
 namespace hexrefine {
@@ -131,21 +139,43 @@ struct SlideState {
   double u = 0.5, v = 0.5;
 };
 
+/// What the workers of one nodes_optimize call share: per problem hex its scaled Jacobian, per
+/// movable node its start and slide state, and the phase. A worker writes only the entries of the
+/// node it visits and of the hexes around it, so workers visiting nodes that share no hex never
+/// touch the same entry.
+struct OptimizerShared {
+  std::vector<double> quality;
+  std::vector<Vec3> start;
+  std::vector<SlideState> state;
+  bool soft_phase = false;
+  double beta = 60.0;
+};
+
+/// One worker: the visits of one thread, with its own scratch buffers, over `shared`.
 class Optimizer {
  public:
-  Optimizer(HexMesh& mesh, const NodeProblem& problem, const NodeOptimizerOptions& options)
-      : mesh_(mesh), problem_(problem), options_(options) {
+  /// `initialize`: this first worker fills `shared` (qualities, start positions, every sliding
+  /// node put on its slide); the others only bind to it.
+  Optimizer(HexMesh& mesh, const NodeProblem& problem, const NodeOptimizerOptions& options,
+            OptimizerShared& shared, bool initialize)
+      : mesh_(mesh),
+        problem_(problem),
+        options_(options),
+        quality_(shared.quality),
+        start_(shared.start),
+        state_(shared.state),
+        shared_(shared) {
+    size_t valence = 0;
+    for (size_t i = 0; i < problem.nodes.size(); ++i)
+      valence = std::max(valence, static_cast<size_t>(problem.node_hex_offsets[i + 1] -
+                                                      problem.node_hex_offsets[i]));
+    trial_.resize(valence);
+    if (!initialize) return;
     quality_.resize(problem.hexes.size());
     mesh_scaled_jacobians(mesh, problem.hexes, quality_);
     state_.resize(problem.nodes.size());
     start_.resize(problem.nodes.size());
-    size_t valence = 0;
-    for (size_t i = 0; i < problem.nodes.size(); ++i) {
-      start_[i] = mesh.points[problem.nodes[i]];
-      valence = std::max(valence, static_cast<size_t>(problem.node_hex_offsets[i + 1] -
-                                                      problem.node_hex_offsets[i]));
-    }
-    trial_.resize(valence);
+    for (size_t i = 0; i < problem.nodes.size(); ++i) start_[i] = mesh.points[problem.nodes[i]];
     for (size_t i = 0; i < problem.nodes.size(); ++i) slide_start(static_cast<int32_t>(i));
   }
 
@@ -434,7 +464,7 @@ class Optimizer {
   /// KS soft minimum of the samples of the hexes around node i at its current position, and its
   /// gradient with respect to the node.
   double soft_min(int32_t i, Vec3& gradient) {
-    const double beta = beta_;
+    const double beta = shared_.beta;
     samples_.clear();
     sample_gradients_.clear();
     for_each_hex(i, [&](int32_t local_hex, const HexCell&, int vertex) {
@@ -475,15 +505,15 @@ class Optimizer {
   /// the node improves; the smooth phase when the soft minimum (low beta) rises and keep_positive
   /// allows it.
   void ascent(int32_t i) {
-    double current = soft_phase_ ? 0.0 : local_min(i);
-    if (!soft_phase_ && current >= 1.0 - 1e-12) return;
+    double current = shared_.soft_phase ? 0.0 : local_min(i);
+    if (!shared_.soft_phase && current >= 1.0 - 1e-12) return;
     const double h = scale(i);
     if (!(h > 0)) return;
     double step = 0.05 * h;
     for (int iteration = 0; iteration < options_.ascent_steps; ++iteration) {
       Vec3 gradient;
       const double soft = soft_min(i, gradient);
-      if (soft_phase_) current = soft;
+      if (shared_.soft_phase) current = soft;
       const Vec3 direction = slide_tangent(i, gradient);
       if (!(direction.norm() > 1e-12 / h)) return;
       const Vec3 unit = direction.normalized();
@@ -495,11 +525,12 @@ class Optimizer {
         if (candidate == x) continue;
         double m;
         const bool better =
-            soft_phase_ ? soft_min_at(i, candidate) > current + 1e-12 && trial_min(i, candidate, m)
-                        : trial_min(i, candidate, m, nullptr, current + 1e-12);
+            shared_.soft_phase
+                ? soft_min_at(i, candidate) > current + 1e-12 && trial_min(i, candidate, m)
+                : trial_min(i, candidate, m, nullptr, current + 1e-12);
         if (!better) continue;
         commit(i, candidate, s);
-        if (!soft_phase_) current = m;
+        if (!shared_.soft_phase) current = m;
         moved = true;
         step = std::min(2 * step, 0.25 * h);
         break;
@@ -512,8 +543,8 @@ class Optimizer {
   /// Switches between the smooth phase (soft minimum with `beta` must rise) and the max-min
   /// phase (the true minimum must rise; beta 60 shapes the direction).
   void set_phase(bool soft, double beta) {
-    soft_phase_ = soft;
-    beta_ = beta;
+    shared_.soft_phase = soft;
+    shared_.beta = beta;
   }
   /// Moves node i to x (a saved position), its state and the qualities updated.
   void restore(int32_t i, const Vec3& x) {
@@ -525,14 +556,15 @@ class Optimizer {
   }
 
  private:
-  bool soft_phase_ = false;
-  double beta_ = 60.0;
   HexMesh& mesh_;
   const NodeProblem& problem_;
   const NodeOptimizerOptions& options_;
-  std::vector<double> quality_, trial_, samples_;
-  std::vector<Vec3> sample_gradients_, start_;
-  std::vector<SlideState> state_;
+  std::vector<double>& quality_;
+  std::vector<Vec3>& start_;
+  std::vector<SlideState>& state_;
+  OptimizerShared& shared_;
+  std::vector<double> trial_, samples_;  // this worker's scratch
+  std::vector<Vec3> sample_gradients_;
 };
 
 void min_mean(const std::vector<double>& q, double& min, double& mean) {
@@ -550,13 +582,20 @@ NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
                                   const NodeOptimizerOptions& options) {
   NodeOptimizerStats stats;
   const int32_t n = static_cast<int32_t>(problem.nodes.size());
-  Optimizer optimizer(mesh, problem, options);
+  const int threads = std::max(options.threads, 1);
+  OptimizerShared shared;
+  std::vector<Optimizer> workers;
+  workers.reserve(static_cast<size_t>(threads));
+  for (int t = 0; t < threads; ++t) workers.emplace_back(mesh, problem, options, shared, t == 0);
+  Optimizer& optimizer = workers.front();
   min_mean(optimizer.quality(), stats.min_before, stats.mean_before);
 
   // Worst-first order by a counting sort on the quantised local minimum (linear, stable by id).
   constexpr int buckets = 4096;
   std::vector<int32_t> bucket_offsets(buckets + 1), order, keys;
   std::vector<char> active(n, 1), next_active(n, 0);
+  // Per node its level in the current sweep (-1: not reached yet); the sweep's nodes by level.
+  std::vector<int32_t> level(n, -1), level_offsets, by_level;
   bool soft = false;  // the smooth phase runs its sweeps to the end (its soft objective)
   auto run_sweeps = [&](int max_sweeps) {
     std::fill(active.begin(), active.end(), 1);
@@ -578,20 +617,68 @@ NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
       for (int32_t i = 0; i < n; ++i)
         if (active[i]) order[bucket_offsets[keys[k++]]++] = i;
 
-      std::fill(next_active.begin(), next_active.end(), 0);
-      double largest_relative_move = 0;
+      // Levels of the worst-first order: a node's level is one above the highest level of the
+      // nodes before it in the order that share a hex with it. A visit reads and writes only
+      // its own node, the nodes and hexes around it: visiting level by level, each node sees
+      // exactly what it would see in the serial worst-first sweep (the nodes before it that it
+      // depends on are in lower levels, those after it in higher ones), so the result is the
+      // serial sweep's, bit for bit, and the nodes of one level, which share no hex, can be
+      // visited in any order on any number of threads.
+      int32_t levels = 0;
       for (int32_t i : order) {
-        // A node visit() would leave (its worst hex at or above visit_below) costs no scale.
-        if (!(optimizer.local_min(i) < options.visit_below)) continue;
-        const double h = optimizer.scale(i);
-        const double moved = optimizer.visit(i);
-        if (!(moved > 0)) continue;
-        if (h > 0) largest_relative_move = std::max(largest_relative_move, moved / h);
-        // Moves below a thousandth of the local edge length do not wake the neighbours.
-        if (h > 0 && moved < 1e-3 * h) continue;
-        for (int32_t k = problem.node_hex_offsets[i]; k < problem.node_hex_offsets[i + 1]; ++k)
-          for (int32_t j : problem.hex_local_nodes[problem.node_hex[k]])
-            if (j >= 0) next_active[j] = 1;
+        int32_t l = 0;
+        for (int32_t m = problem.node_hex_offsets[i]; m < problem.node_hex_offsets[i + 1]; ++m)
+          for (int32_t j : problem.hex_local_nodes[problem.node_hex[m]])
+            if (j >= 0 && j != i && level[j] >= l) l = level[j] + 1;
+        level[i] = l;
+        levels = std::max(levels, l + 1);
+      }
+      level_offsets.assign(static_cast<size_t>(levels) + 1, 0);
+      for (int32_t i : order) ++level_offsets[level[i] + 1];
+      for (int32_t l = 0; l < levels; ++l) level_offsets[l + 1] += level_offsets[l];
+      by_level.resize(order.size());
+      for (int32_t i : order) by_level[level_offsets[level[i]]++] = i;
+      for (int32_t i : order) level[i] = -1;
+      for (int32_t l = levels; l > 0; --l) level_offsets[l] = level_offsets[l - 1];
+      level_offsets[0] = 0;
+
+      std::fill(next_active.begin(), next_active.end(), 0);
+      std::vector<double> largest_relative_move(static_cast<size_t>(threads), 0.0);
+      // Visits every stride-th node of by_level[begin, end), from `begin`.
+      auto visit_nodes = [&](Optimizer& worker, int64_t w, int64_t begin, int64_t end,
+                             int64_t stride) {
+        for (int64_t at = begin; at < end; at += stride) {
+          const int32_t i = by_level[at];
+          const double h = worker.scale(i);
+          const double moved = worker.visit(i);
+          if (!(moved > 0)) continue;
+          if (h > 0) largest_relative_move[w] = std::max(largest_relative_move[w], moved / h);
+          // Moves below a thousandth of the local edge length do not wake the neighbours.
+          if (h > 0 && moved < 1e-3 * h) continue;
+          for (int32_t m = problem.node_hex_offsets[i]; m < problem.node_hex_offsets[i + 1]; ++m)
+            for (int32_t j : problem.hex_local_nodes[problem.node_hex[m]])
+              if (j >= 0) std::atomic_ref<char>(next_active[j]).store(1, std::memory_order_relaxed);
+        }
+      };
+      for (int32_t l = 0; l < levels; ++l) {
+        // The nodes visit() would leave (their worst hex at or above visit_below, which within
+        // a level only their own visit changes) cost nothing: dropped first, so that the
+        // threads share the nodes that do cost.
+        int64_t end = level_offsets[l];
+        for (int64_t at = level_offsets[l]; at < level_offsets[l + 1]; ++at)
+          if (optimizer.local_min(by_level[at]) < options.visit_below)
+            by_level[end++] = by_level[at];
+        const int64_t begin = level_offsets[l], size = end - begin;
+        // Small levels are not worth a thread.
+        if (threads == 1 || size < 64) {
+          visit_nodes(optimizer, 0, begin, end, 1);
+          continue;
+        }
+        // Worker w visits every threads-th node from begin + w: the worst nodes, which cost
+        // most, are spread over the workers.
+        parallel_chunks(threads, threads, 1, [&](int64_t w, int64_t, int64_t) {
+          visit_nodes(workers[w], w, begin + w, end, threads);
+        });
       }
       active.swap(next_active);
       ++stats.sweeps;
@@ -600,7 +687,9 @@ NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
       const bool stalled = sweep_min - current_min <= 1e-9 && sweep_mean - current_mean <= 1e-6;
       current_min = sweep_min;
       current_mean = sweep_mean;
-      if (largest_relative_move <= 1e-7 || (stalled && !soft)) break;
+      const double largest =
+          *std::max_element(largest_relative_move.begin(), largest_relative_move.end());
+      if (largest <= 1e-7 || (stalled && !soft)) break;
     }
   };
   std::vector<Vec3> saved;

@@ -81,6 +81,8 @@ struct NodeOptimizerOptions {
   /// in a long parent). The problem's minimum is restored if this phase lowered it.
   int smooth_sweeps = 0;
   double smooth_beta = 8.0;
+  /// Threads visiting the nodes of a colour class (>= 1; the result is the same for any count).
+  int threads = 1;
 };
 
 struct NodeOptimizerStats {
@@ -90,8 +92,10 @@ struct NodeOptimizerStats {
   double min_before = 1, min_after = 1, mean_before = 1, mean_after = 1;
 };
 
-/// Moves problem.nodes in `mesh` (see the file comment); deterministic (worst-first order with
-/// ties by node id, serial). The minimum over problem.hexes never decreases.
+/// Moves problem.nodes in `mesh` (see the file comment); deterministic: the result is that of
+/// serial Gauss-Seidel sweeps in worst-first order (ties by node id) for any options.threads,
+/// which visit the nodes of one dependency level at a time. The minimum over problem.hexes never
+/// decreases.
 NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
                                   const NodeOptimizerOptions& options);
 

@@ -373,6 +373,7 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
   optimizer.keep_positive = false;
   optimizer.max_sweeps = options.max_sweeps;
   optimizer.smooth_sweeps = options.smooth_sweeps;
+  optimizer.threads = pass.threads;
   const NodeOptimizerStats run = nodes_optimize(refined, problem, optimizer);
   stats.sweeps = std::max(stats.sweeps, run.sweeps);
   stats.nodes_moved += run.nodes_moved;

@@ -246,6 +246,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
         boundary_reference_build(input, topology_build(input, TopologyParts::faces));
     so.reference = &reference;
     so.reference_nodes = input.point_count();
+    so.threads = o.refine.threads;
     clock.begin("smooth");
     r.smoothing = mesh_smooth(r.mesh, so);
     clock.end("smooth");

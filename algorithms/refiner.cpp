@@ -196,7 +196,8 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
             original ? std::span<const int32_t>(*original) : std::span<const int32_t>(),
             reference,
             options.allow_inverted,
-            attempt == placement_retries};
+            attempt == placement_retries,
+            options.threads};
         failed = place_new_nodes(placement, applied.mesh, options.placement, stats.placement);
       }
       stats.phase_seconds["placement"] += seconds_since(t);

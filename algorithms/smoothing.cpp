@@ -350,6 +350,7 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
   o.max_sweeps = options.max_sweeps;
   o.ascent_steps = 3;
   o.visit_below = options.visit_below;
+  o.threads = options.threads;
   const NodeOptimizerStats run = nodes_optimize(mesh, problem, o);
   stats.sweeps = run.sweeps;
   stats.nodes_moved = run.nodes_moved;

@@ -69,6 +69,7 @@ struct SmoothOptions {
   /// nullptr: boundary nodes slide on the mesh's own boundary quads (SmoothNodeKind).
   const BoundaryReference* reference = nullptr;
   int32_t reference_nodes = 0;
+  int threads = 1;  ///< >= 1: threads for the node visits (the result is the same for any count)
 };
 
 struct SmoothStats {

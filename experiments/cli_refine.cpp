@@ -150,8 +150,8 @@ const CliCommand cli_refine_command = {
         {"--ascii", "", "VTU output as text instead of appended binary data (.vtu only)"},
         {"--compress", "", "VTU output zlib-compressed (.vtu only)"},
         {"--threads", "N",
-         "threads for the template application and the check, 1..256 (same output; default: "
-         "every core)"},
+         "threads for the template application, node placement, smoothing, the check and the "
+         "write, 1..256 (same output; default: every core)"},
         {"--report", "R.json", "write the JSON report (stats, checks, stage times)"},
         {"--verbose", "", "print each stage's time on stderr as it ends"},
     },

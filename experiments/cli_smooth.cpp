@@ -50,6 +50,7 @@ int smooth_run(const CliArgs& a) {
       throw InputError("hexrefine smooth: --sweeps must be in 0..1000000, got " + *sweeps);
     options.max_sweeps = static_cast<int>(n);
   }
+  options.threads = cli_threads(a.value("--threads"));
   const std::vector<std::string> region_specs = a.all("--region");
   const std::optional<std::string> report_path = a.value("--report");
   if (report_path) cli_output_check("hexrefine smooth", *report_path, CliOutputKind::report);
@@ -102,6 +103,8 @@ const CliCommand cli_smooth_command = {
         {"--method", "M", "laplacian or optimize (default optimize)"},
         {"--region", "SPEC", "move only the nodes of these hexes (selection specs, united)", true},
         {"--sweeps", "N", "at most N sweeps, 0..1000000 (default 20)"},
+        {"--threads", "N",
+         "threads for the node visits, 1..256 (same output; default: every core)"},
         {"--report", "R.json", "write the JSON report"},
     },
     "",

@@ -42,7 +42,8 @@
 /// applied to Gauss-Seidel). A visit reads and writes only its node and what lies in the hexes
 /// around it, so visiting level by level replays the serial sweep exactly, and the nodes of one
 /// level, which share no hex, are visited by several workers (each with its own scratch) at
-/// once. Output is bit-identical for any thread count and to the serial sweep.
+/// once. One thread visits in the worst-first order itself (no levels to build). Output is
+/// bit-identical for any thread count.
 
 #include "algorithms/node_optimizer.hpp"
 
@@ -617,38 +618,15 @@ NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
       for (int32_t i = 0; i < n; ++i)
         if (active[i]) order[bucket_offsets[keys[k++]]++] = i;
 
-      // Levels of the worst-first order: a node's level is one above the highest level of the
-      // nodes before it in the order that share a hex with it. A visit reads and writes only
-      // its own node, the nodes and hexes around it: visiting level by level, each node sees
-      // exactly what it would see in the serial worst-first sweep (the nodes before it that it
-      // depends on are in lower levels, those after it in higher ones), so the result is the
-      // serial sweep's, bit for bit, and the nodes of one level, which share no hex, can be
-      // visited in any order on any number of threads.
-      int32_t levels = 0;
-      for (int32_t i : order) {
-        int32_t l = 0;
-        for (int32_t m = problem.node_hex_offsets[i]; m < problem.node_hex_offsets[i + 1]; ++m)
-          for (int32_t j : problem.hex_local_nodes[problem.node_hex[m]])
-            if (j >= 0 && j != i && level[j] >= l) l = level[j] + 1;
-        level[i] = l;
-        levels = std::max(levels, l + 1);
-      }
-      level_offsets.assign(static_cast<size_t>(levels) + 1, 0);
-      for (int32_t i : order) ++level_offsets[level[i] + 1];
-      for (int32_t l = 0; l < levels; ++l) level_offsets[l + 1] += level_offsets[l];
-      by_level.resize(order.size());
-      for (int32_t i : order) by_level[level_offsets[level[i]]++] = i;
-      for (int32_t i : order) level[i] = -1;
-      for (int32_t l = levels; l > 0; --l) level_offsets[l] = level_offsets[l - 1];
-      level_offsets[0] = 0;
-
       std::fill(next_active.begin(), next_active.end(), 0);
       std::vector<double> largest_relative_move(static_cast<size_t>(threads), 0.0);
-      // Visits every stride-th node of by_level[begin, end), from `begin`.
-      auto visit_nodes = [&](Optimizer& worker, int64_t w, int64_t begin, int64_t end,
-                             int64_t stride) {
+      // Visits every stride-th node of nodes[begin, end), from `begin`.
+      auto visit_nodes = [&](Optimizer& worker, int64_t w, const std::vector<int32_t>& nodes,
+                             int64_t begin, int64_t end, int64_t stride) {
         for (int64_t at = begin; at < end; at += stride) {
-          const int32_t i = by_level[at];
+          const int32_t i = nodes[at];
+          // A node visit() would leave (its worst hex at or above visit_below) costs no scale.
+          if (!(worker.local_min(i) < options.visit_below)) continue;
           const double h = worker.scale(i);
           const double moved = worker.visit(i);
           if (!(moved > 0)) continue;
@@ -660,25 +638,53 @@ NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
               if (j >= 0) std::atomic_ref<char>(next_active[j]).store(1, std::memory_order_relaxed);
         }
       };
-      for (int32_t l = 0; l < levels; ++l) {
-        // The nodes visit() would leave (their worst hex at or above visit_below, which within
-        // a level only their own visit changes) cost nothing: dropped first, so that the
-        // threads share the nodes that do cost.
-        int64_t end = level_offsets[l];
-        for (int64_t at = level_offsets[l]; at < level_offsets[l + 1]; ++at)
-          if (optimizer.local_min(by_level[at]) < options.visit_below)
-            by_level[end++] = by_level[at];
-        const int64_t begin = level_offsets[l], size = end - begin;
-        // Small levels are not worth a thread.
-        if (threads == 1 || size < 64) {
-          visit_nodes(optimizer, 0, begin, end, 1);
-          continue;
+      if (threads == 1) {
+        visit_nodes(optimizer, 0, order, 0, static_cast<int64_t>(order.size()), 1);
+      } else {
+        // Levels of the worst-first order: a node's level is one above the highest level of
+        // the nodes before it in the order that share a hex with it. A visit reads and writes
+        // only its own node, the nodes and hexes around it: visiting level by level, each node
+        // sees exactly what it would see in the serial sweep above (the nodes before it that it
+        // depends on are in lower levels, those after it in higher ones), so the result is the
+        // serial sweep's, bit for bit, and the nodes of one level, which share no hex, can be
+        // visited in any order on any number of threads.
+        int32_t levels = 0;
+        for (int32_t i : order) {
+          int32_t l = 0;
+          for (int32_t m = problem.node_hex_offsets[i]; m < problem.node_hex_offsets[i + 1]; ++m)
+            for (int32_t j : problem.hex_local_nodes[problem.node_hex[m]])
+              if (j >= 0 && j != i && level[j] >= l) l = level[j] + 1;
+          level[i] = l;
+          levels = std::max(levels, l + 1);
         }
-        // Worker w visits every threads-th node from begin + w: the worst nodes, which cost
-        // most, are spread over the workers.
-        parallel_chunks(threads, threads, 1, [&](int64_t w, int64_t, int64_t) {
-          visit_nodes(workers[w], w, begin + w, end, threads);
-        });
+        level_offsets.assign(static_cast<size_t>(levels) + 1, 0);
+        for (int32_t i : order) ++level_offsets[level[i] + 1];
+        for (int32_t l = 0; l < levels; ++l) level_offsets[l + 1] += level_offsets[l];
+        by_level.resize(order.size());
+        for (int32_t i : order) by_level[level_offsets[level[i]]++] = i;
+        for (int32_t i : order) level[i] = -1;
+        for (int32_t l = levels; l > 0; --l) level_offsets[l] = level_offsets[l - 1];
+        level_offsets[0] = 0;
+        for (int32_t l = 0; l < levels; ++l) {
+          // The nodes visit() would leave (their worst hex at or above visit_below, which
+          // within a level only their own visit changes) cost nothing: dropped first, so that
+          // the threads share the nodes that do cost.
+          int64_t end = level_offsets[l];
+          for (int64_t at = level_offsets[l]; at < level_offsets[l + 1]; ++at)
+            if (optimizer.local_min(by_level[at]) < options.visit_below)
+              by_level[end++] = by_level[at];
+          const int64_t begin = level_offsets[l], size = end - begin;
+          // Small levels are not worth a thread.
+          if (size < 64) {
+            visit_nodes(optimizer, 0, by_level, begin, end, 1);
+            continue;
+          }
+          // Worker w visits every threads-th node from begin + w: the worst nodes, which cost
+          // most, are spread over the workers.
+          parallel_chunks(threads, threads, 1, [&](int64_t w, int64_t, int64_t) {
+            visit_nodes(workers[w], w, by_level, begin + w, end, threads);
+          });
+        }
       }
       active.swap(next_active);
       ++stats.sweeps;

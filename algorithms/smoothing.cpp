@@ -35,12 +35,14 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <string>
 #include <unordered_map>
 
 #include "algorithms/node_optimizer.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
+#include "mesh/hex_face_adjacency.hpp"
 #include "mesh/quality.hpp"
 
 namespace hexrefine {
@@ -203,7 +205,6 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
 
   // 2. Movable nodes and their slides, from the part's boundary.
   const SubMesh sub = mesh_extract(mesh, part);
-  const HexTopology topology = topology_build(sub.mesh);
   std::vector<uint8_t> in_region(sub.mesh.points.size(), 0);
   {
     std::vector<int32_t> local_of_part(mesh.hexes.size(), -1);
@@ -215,9 +216,15 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
   if (options.reference) {
     const std::vector<int32_t>* parent = mesh_find_attribute(mesh, attribute_parent_hex);
     if (!parent) throw InputError("mesh_smooth: a reference needs the mesh's parent_hex attribute");
+    // The part's boundary nodes and the hexes around each node, from matched faces and one
+    // counting sort: no general topology (its edges and face ids) is needed here.
     std::vector<uint8_t> boundary(sub.mesh.points.size(), 0);
-    for (int32_t f : topology_boundary_faces(topology))
-      for (int32_t n : topology.face_nodes[f]) boundary[n] = 1;
+    for (const HexFaceSlot& f :
+         hex_face_adjacency_build(sub.mesh, options.threads, false).boundary_faces)
+      for (int k = 0; k < 4; ++k) boundary[sub.mesh.hexes[f.hex][hex_faces[f.local_face][k]]] = 1;
+    std::vector<int32_t> sub_hexes(sub.mesh.hexes.size()), hex_offsets, hex_items;
+    std::iota(sub_hexes.begin(), sub_hexes.end(), 0);
+    node_hexes_of(sub.mesh, sub_hexes, hex_offsets, hex_items);
     ReferenceSlides slides(*options.reference, problem.geometry);
     // On a planar-faced input every kink between its faces is its geometry (the checker holds
     // such an output to the input's volume and area): input nodes slide only across flat
@@ -239,7 +246,8 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
       NodeSlide slide;
       if (boundary[n]) {
         around.clear();
-        for (int32_t h : node_hexes(topology, n)) around.push_back((*parent)[part[h]]);
+        for (int32_t k = hex_offsets[n]; k < hex_offsets[n + 1]; ++k)
+          around.push_back((*parent)[part[hex_items[k]]]);
         std::sort(around.begin(), around.end());
         around.erase(std::unique(around.begin(), around.end()), around.end());
         const std::optional<NodeSlide> s =
@@ -258,6 +266,7 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
       problem.slides.push_back(slide);
     }
   } else {
+    const HexTopology topology = topology_build(sub.mesh);
     const SmoothNodeClasses classes =
         mesh_classify_smooth_nodes(sub.mesh, topology, options.feature_angle_degrees);
     // Boundary quads and feature edges around each node, by the part's topology.

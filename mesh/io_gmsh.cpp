@@ -436,30 +436,44 @@ void gmsh_element_data_read(GmshNumbers& in, GmshRead& g) {
   in.begin_values();
   const bool keep = components == 1 && !d.name.empty();
   if (keep) d.values.reserve(static_cast<size_t>(count));
-  for (int64_t i = 0; i < count; ++i) {
-    const int64_t tag = in.binary() ? in.int_value("element tag") : text.integer("element tag");
-    for (int64_t c = 0; c < components; ++c) {
-      double v = 0.5;  // NaN/inf: not an integer attribute
-      if (in.binary()) {
-        const char* p = text.raw(8, "element data value", false);
-        std::memcpy(&v, p, 8);
-        if (!std::isfinite(v)) v = 0.5;
-      } else if (!TextCursor::parse_real(text.token("element data value"), v)) {
-        v = 0.5;
+  // Value v (NaN or infinite: 0.5, not an integer) of the element with tag `tag`, the i-th.
+  auto take = [&](int64_t i, int64_t tag, double v) {
+    if (!keep || !d.integral) return;
+    if (v != std::floor(v) || v < INT32_MIN || v > INT32_MAX) {
+      d.integral = false;
+      d.values = {};
+      d.tags = {};
+      return;
+    }
+    if (d.tags.empty() && tag != i + 1) {  // tags not 1, 2, ...: keep them from here on
+      d.tags.reserve(static_cast<size_t>(count));
+      for (int64_t k = 0; k < i; ++k) d.tags.push_back(k + 1);
+    }
+    if (!d.tags.empty() || tag != i + 1) d.tags.push_back(tag);
+    d.values.push_back(static_cast<int32_t>(v));
+  };
+  if (in.binary()) {
+    // Records of an int tag and `components` doubles: the whole block taken at once (its size
+    // was checked against the file above), then read in place.
+    const size_t record = 4 + 8 * static_cast<size_t>(components);
+    const char* p = text.raw(static_cast<size_t>(count) * record, "element data", false);
+    for (int64_t i = 0; i < count; ++i, p += record) {
+      int32_t tag;
+      std::memcpy(&tag, p, 4);
+      for (int64_t c = 0; c < components; ++c) {
+        double v;
+        std::memcpy(&v, p + 4 + 8 * c, 8);
+        take(i, tag, std::isfinite(v) ? v : 0.5);
       }
-      if (!keep || !d.integral) continue;
-      if (v != std::floor(v) || v < INT32_MIN || v > INT32_MAX) {
-        d.integral = false;
-        d.values = {};
-        d.tags = {};
-        continue;
+    }
+  } else {
+    for (int64_t i = 0; i < count; ++i) {
+      const int64_t tag = text.integer("element tag");
+      for (int64_t c = 0; c < components; ++c) {
+        double v = 0.5;
+        if (!TextCursor::parse_real(text.token("element data value"), v)) v = 0.5;
+        take(i, tag, v);
       }
-      if (d.tags.empty() && tag != i + 1) {  // tags not 1, 2, ...: keep them from here on
-        d.tags.reserve(static_cast<size_t>(count));
-        for (int64_t k = 0; k < i; ++k) d.tags.push_back(k + 1);
-      }
-      if (!d.tags.empty() || tag != i + 1) d.tags.push_back(tag);
-      d.values.push_back(static_cast<int32_t>(v));
     }
   }
   text.expect("$EndElementData");

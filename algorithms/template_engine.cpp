@@ -458,6 +458,8 @@ void mesh_attributes_from_parents(const HexMesh& input, std::span<const int32_t>
     for (size_t i = 0; i < n; ++i) copy.values[i] = attr.values[parent[i]];
     output.attributes.push_back(std::move(copy));
   }
+  // Room for the three attributes added here, so creating `level` does not move `tag`.
+  output.attributes.reserve(output.attributes.size() + 3);
   std::vector<int32_t>& tag = mesh_attribute(output, attribute_template_tag, 0);
   std::vector<int32_t>& level = mesh_attribute(output, attribute_refinement_level, 0);
   for (size_t i = 0; i < n; ++i) {

@@ -45,6 +45,8 @@ struct HexMesh {
 const std::vector<int32_t>* mesh_find_attribute(const HexMesh& mesh, std::string_view name);
 
 /// The attribute named `name`, created (filled with `fill`) if absent or resized if stale.
+/// Creating an attribute may move the others: a reference held across a call that creates one
+/// dangles (reserve mesh.attributes first).
 std::vector<int32_t>& mesh_attribute(HexMesh& mesh, std::string_view name, int32_t fill = 0);
 
 /// Throws InputError naming the hex if a node id is out of range, a hex repeats a node, or an

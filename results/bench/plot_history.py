@@ -21,8 +21,9 @@ here = os.path.dirname(os.path.abspath(__file__))
 parser = argparse.ArgumentParser()
 parser.add_argument("history", nargs="?", default=os.path.join(here, "history.jsonl"))
 parser.add_argument("--pattern",
-                    default=r"bench_(full_brick|radial)/(selective|sheet)/50/|bench_command/|bench_real_mesh/"
-                            r"exodus(_2_threads)?/50/|bench_check_brick(_2_threads)?/50/")
+                    default=r"bench_(full_brick|radial)/(selective|sheet)/50/|bench_command/"
+                            r"exodus(_2_threads)?/50/|bench_check_brick(_2_threads)?/50/"
+                            r"|bench_real_mesh/")
 parser.add_argument("--out", default=os.path.join(here, "history.png"))
 args = parser.parse_args()
 

@@ -1,4 +1,5 @@
-// `hexrefine refine --threads N`: the parallel template application writes the same file.
+// `hexrefine refine --threads N`: the parallel template application, node placement, smoothing
+// and the write beside the check give the same file.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -15,7 +16,7 @@ TEST(CliRefineThreads, SameFileForAnyThreadCount) {
   ASSERT_EQ(cli_run("generate brick " + brick + " --dims 6,6,6 --jitter 0.2 --seed 3").exit_code,
             0);
   for (const char* method : {"selective", "sheet"}) {
-    for (const char* select : {"all", "sphere:0,0,0,2.5"}) {
+    for (const char* select : {"all", "sphere:0,0,0,2.5", "sphere:0,0,0,2.5 --smooth"}) {
       std::string first;
       for (int threads : {1, 2, 4}) {
         const std::string out = (dir / ("out" + std::to_string(threads) + ".mesh")).string();

@@ -62,6 +62,33 @@ TEST(CliSmooth, SmoothsWritesMeshAndReport) {
   }
 }
 
+TEST(CliSmooth, SameFileForAnyThreadCount) {
+  // A 20^3 jittered brick (8,000 hexes), three sweeps: nine of the optimizer's levels hold the
+  // 64 nodes or more at which the threads share them (counted once with a print).
+  const auto dir = test_temp_dir("cli_smooth_threads");
+  BrickParams p;
+  p.dims = {20, 20, 20};
+  p.jitter = 0.35;
+  p.seed = 11;
+  const std::string in = (dir / "jittered.vtu").string();
+  mesh_write(in, generate_brick(p));
+  std::string first;
+  for (const char* threads : {"1", "2", "3"}) {
+    const std::string out = (dir / (std::string("out") + threads + ".vtu")).string();
+    const CliRun r = cli_run("smooth " + in + " " + out + " --sweeps 3 --threads " + threads);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string text = test_file_text(out);
+    if (first.empty())
+      first = text;
+    else
+      EXPECT_EQ(text, first) << threads << " threads";
+  }
+  EXPECT_NE(first, test_file_text(in));  // it did move nodes
+  const CliRun bad = cli_run("smooth " + in + " " + (dir / "o.vtu").string() + " --threads 0");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--threads"), std::string::npos) << bad.output;
+}
+
 TEST(CliSmooth, RegionAndSweepsLimitTheMoves) {
   const auto dir = test_temp_dir("cli_smooth_region");
   const std::string in = write_jittered_brick(dir);

@@ -24,6 +24,10 @@ class StagedMeshWrite {
  public:
   /// Starts writing `mesh` for `path` (mesh_write's format, checks and options).
   StagedMeshWrite(const std::string& path, const HexMesh& mesh, const MeshWriteOptions& options);
+  /// The writer reads the mesh and options after the constructor returns: temporaries would be
+  /// gone by then.
+  StagedMeshWrite(const std::string&, HexMesh&&, const MeshWriteOptions&) = delete;
+  StagedMeshWrite(const std::string&, const HexMesh&, MeshWriteOptions&&) = delete;
   ~StagedMeshWrite();
   StagedMeshWrite(const StagedMeshWrite&) = delete;
   StagedMeshWrite& operator=(const StagedMeshWrite&) = delete;

@@ -29,12 +29,13 @@ std::vector<std::string> folder_names(const fs::path& dir) {
 TEST(StagedMeshWrite, OutputAppearsOnlyOnCommitWithTheBytesOfMeshWrite) {
   const auto dir = test_temp_dir("staged_commit");
   const HexMesh m = fixture_brick(3, 2, 2);
+  const MeshWriteOptions options;  // outlives the writers
   for (const char* name : {"m.vtu", "m.e", "m.msh"}) {
     SCOPED_TRACE(name);
     const fs::path direct = dir / ("direct" + fs::path(name).extension().string());
     mesh_write(direct.string(), m);
     const fs::path out = dir / name;
-    StagedMeshWrite staged(out.string(), m, MeshWriteOptions{});
+    StagedMeshWrite staged(out.string(), m, options);
     staged.finish();
     EXPECT_FALSE(fs::exists(out));  // written, not yet committed
     staged.commit();
@@ -56,7 +57,8 @@ TEST(StagedMeshWrite, WithoutCommitTheOldFileStaysAndNothingIsLeft) {
   const std::string good = test_file_text(out);
   {
     const HexMesh m = fixture_brick(4, 4, 4);
-    StagedMeshWrite staged(out.string(), m, MeshWriteOptions{});
+    const MeshWriteOptions options;
+    StagedMeshWrite staged(out.string(), m, options);
     // Destroyed while (or after) writing: the verdict refused the mesh, or something threw.
   }
   EXPECT_EQ(test_file_text(out), good);
@@ -68,7 +70,8 @@ TEST(StagedMeshWrite, WriterErrorsNameTheOutputAndKeepTheirKind) {
   const fs::path out = dir / "m.vtk";
   HexMesh bad = fixture_brick(2, 1, 1);
   bad.hexes[1][3] = 99;  // a node the mesh does not have
-  StagedMeshWrite staged(out.string(), bad, MeshWriteOptions{});
+  const MeshWriteOptions options;
+  StagedMeshWrite staged(out.string(), bad, options);
   try {
     staged.finish();
     FAIL() << "wrote a mesh with a bad node id";

@@ -302,7 +302,9 @@ PYBIND11_MODULE(_hexrefine, m) {
       "against the input, optionally smooth and check again. Returns (mesh, report): the mesh "
       "with template_tag, refinement_level and parent_hex attributes, the report a dict with the "
       "keys of `hexrefine refine --report`. `buffer` (passes > 1): 'layer' (the thesis' rule), "
-      "'transitions' or 'none'. RefinementError if the method refuses or the result "
+      "'transitions' or 'none'. `threads`: for the template application, node placement, "
+      "smoothing and the check (the same mesh for any count). RefinementError if the method "
+      "refuses or the result "
       "is invalid (unless an ablation switch or allow_inverted); ValueError for bad input.");
   m.def(
       "check",

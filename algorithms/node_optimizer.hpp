@@ -81,7 +81,8 @@ struct NodeOptimizerOptions {
   /// in a long parent). The problem's minimum is restored if this phase lowered it.
   int smooth_sweeps = 0;
   double smooth_beta = 8.0;
-  /// Threads visiting the nodes of a colour class (>= 1; the result is the same for any count).
+  /// Threads visiting the nodes of one dependency level of a sweep at once (>= 1; the result is
+  /// the same for any count).
   int threads = 1;
 };
 

@@ -122,7 +122,7 @@ struct PlacementPass {
   /// input hexes and their scaled Jacobians; false, the parents are returned to the caller (the
   /// refinement driver then makes them targets and plans the pass again, refiner.cpp).
   bool refuse = true;
-  int threads = 1;  ///< for the node optimizer's colour classes (same result for any count)
+  int threads = 1;  ///< for the node optimizer's levels (same result for any count)
 };
 
 /// Moves the new nodes of `refined` (the pass's output, its nodes from current.point_count() on

@@ -91,6 +91,13 @@ void size_bound_check(const HexMesh& input, const PipelineOptions& o) {
                        "refined or written: use fewer passes");
 }
 
+/// An InputError of the output's writer (e.g. a field name its format cannot hold): it names the
+/// output, so pipeline_run_files does not put the input's path in front of it.
+class OutputWriteError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// Throws when `check` (of `mesh`, refined from `input`) is invalid and no switch allows it.
 void verdict_enforce(const MeshCheckReport& check, const HexMesh& mesh, const HexMesh& input,
                      const PipelineOptions& o, bool ablation, const std::string& what) {
@@ -207,12 +214,12 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
   // Checks the mesh; the check of the final mesh runs beside its write to `out` when there is
   // more than one thread (the writer takes a thread of its own; one thread: one after the
   // other). The written file becomes `out` only once the verdict allows it.
-  auto check_and_write = [&](const std::string& stage, MeshCheckReport& check,
-                             double& children_min_scaled_jacobian, bool final_mesh,
-                             const std::string& what) {
+  auto mesh_check_and_write = [&](const std::string& stage, MeshCheckReport& check,
+                                  double& children_min_scaled_jacobian, bool final_mesh,
+                                  const std::string& what) {
     std::optional<StagedMeshWrite> staged;
     if (final_mesh && !out.empty() && o.refine.threads > 1) {
-      clock.begin(stage + " and write");
+      clock.begin(stage == "check" ? "check and write" : "check (smoothed) and write");
       staged.emplace(out, r.mesh, o.write);
     }
     check = mesh_check(r.mesh, &input, o.refine.threads);
@@ -226,7 +233,11 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
         clock.begin("write");
         staged.emplace(out, r.mesh, o.write);
       }
-      staged->commit();
+      try {
+        staged->commit();
+      } catch (const InputError& e) {
+        throw OutputWriteError(e.what());  // names the output: no input prefix (below)
+      }
       r.stage_seconds["write"] = staged->seconds();
       r.stage_cpu_seconds["write"] = staged->cpu_seconds();
       if (o.verbose)
@@ -235,8 +246,8 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     }
   };
 
-  check_and_write("check", r.check, r.children_min_scaled_jacobian, smooth_region.empty(),
-                  "the " + o.method + " refiner");
+  mesh_check_and_write("check", r.check, r.children_min_scaled_jacobian, smooth_region.empty(),
+                       "the " + o.method + " refiner");
   if (!smooth_region.empty()) {
     SmoothOptions so = o.smoothing;
     so.region_hexes = std::move(smooth_region);
@@ -253,8 +264,8 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     clock.begin("check (smoothed)");
     r.smoothed_check.emplace();
     r.smoothed_children_min_scaled_jacobian.emplace();
-    check_and_write("check_smoothed", *r.smoothed_check, *r.smoothed_children_min_scaled_jacobian,
-                    true, "smoothing");
+    mesh_check_and_write("check_smoothed", *r.smoothed_check,
+                         *r.smoothed_children_min_scaled_jacobian, true, "smoothing");
   }
   r.stage_seconds["total"] = seconds_since(start);
   r.peak_memory_mb = process_peak_memory_mb();
@@ -278,6 +289,8 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
   PipelineResult r;
   try {
     r = pipeline_run_writing(input, options, out);
+  } catch (const OutputWriteError&) {
+    throw;
   } catch (const InputError& e) {
     throw InputError(in + ": " + e.what());  // the input, or a spec applied to it
   }

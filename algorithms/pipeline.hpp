@@ -86,7 +86,8 @@ struct PipelineResult {
   /// Seconds per stage: read, select, refine, check, smooth, check_smoothed, write, total
   /// (read and write only from pipeline_run_files).
   std::map<std::string, double> stage_seconds;
-  /// Process CPU seconds per stage (all threads): on a shared machine the better measure of
+  /// Process CPU seconds per stage (all threads; "write" is the writer thread's own and the
+  /// final check's leaves it out when they overlap): on a shared machine the better measure of
   /// single-threaded stages, whose wall time includes waiting.
   std::map<std::string, double> stage_cpu_seconds;
   double peak_memory_mb = 0;  ///< the process's peak resident size when the pipeline ended

@@ -74,9 +74,11 @@ struct RefineOptions {
   int passes = 1;           ///< Refine the region this many times.
   PassBuffer buffer = PassBuffer::layer;  ///< Selective, passes > 1: what joins the targets.
   bool allow_inverted = false;            ///< Refine an input with inverted hexes (no refusal).
-  /// Threads for applying whole-hex templates (the assembly of the output). The output is
-  /// identical for every count: node ids are claimed in hex order first, then the positions
-  /// and children are written in parallel. 1: everything in the calling thread.
+  /// Threads for applying whole-hex templates (the assembly of the output) and for the node
+  /// optimizer of the placement (and, in the pipeline, smoothing, the check and the write).
+  /// The output is identical for every count: node ids are claimed in hex order first, then
+  /// the positions and children are written in parallel; the optimizer visits the nodes of one
+  /// dependency level at once. 1: everything in the calling thread.
   int threads = 1;
   PlacementOptions placement;  ///< where the new nodes go after each pass
 };

@@ -56,8 +56,11 @@ class QuadGrid {
         const Eigen::Vector3d grow = Eigen::Vector3d::Constant(tolerances[i]);
         // find()'s box test: a little wider than the tolerance, so that rounding in
         // quad_distance never makes it refuse a quad the distance would accept.
+        // Rounding grows with the coordinates too (meshes far from the origin).
+        const double magnitude = std::max(qlo.cwiseAbs().maxCoeff(), qhi.cwiseAbs().maxCoeff());
         const Eigen::Vector3d margin =
-            grow + Eigen::Vector3d::Constant(1e-9 * (tolerances[i] + (qhi - qlo).maxCoeff()));
+            grow + Eigen::Vector3d::Constant(1e-9 * (tolerances[i] + (qhi - qlo).maxCoeff()) +
+                                             1e-12 * magnitude);
         box_lo_[i] = qlo - margin;
         box_hi_[i] = qhi + margin;
         const auto a = cell_of(qlo - grow), b = cell_of(qhi + grow);
@@ -408,8 +411,8 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   // lying on another boundary face of this mesh.
   std::vector<int32_t> non_conformal;  // indices into surface
   if (reference) {
-    const BoundarySurface reference_surface =
-        boundary_surface(*reference, hex_face_adjacency_build(*reference, threads).boundary_faces);
+    const BoundarySurface reference_surface = boundary_surface(
+        *reference, hex_face_adjacency_build(*reference, threads, false).boundary_faces);
     const QuadGrid grid(reference_surface.quads, reference_surface.tolerances);
     non_conformal = boundary_faces_where(threads, surface, [&](int32_t i) {
       const Quad& q = surface.quads[i];

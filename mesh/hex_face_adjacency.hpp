@@ -35,9 +35,11 @@ struct HexFaceAdjacency {
   /// Each face used by more than two hexes, as its lowest hex's slot, in the same face order.
   std::vector<HexFaceSlot> nonmanifold_faces;
   /// Doublets: pairs of hexes that share two or more faces (as node sets), each pair once as its
-  /// lower hex, ascending. Found while matching, from the two lowest users of each face, so no
-  /// neighbour array is needed; on faces with more than two users (non-manifold, an invalid mesh
-  /// anyway) the other users are not paired.
+  /// lower hex, ascending (a hex in several pairs repeats). Found while matching, from the two
+  /// lowest users of each face, counted at the pair's lowest shared face in its lower hex's
+  /// order, so no neighbour array is needed. Where faces have more than two users
+  /// (non-manifold: an invalid mesh anyway) a pair may go uncounted: the other users are not
+  /// paired, and a pair whose lowest shared face has a third user below its second is missed.
   std::vector<int32_t> doublets;
 };
 

@@ -437,7 +437,7 @@ void gmsh_element_data_read(GmshNumbers& in, GmshRead& g) {
   const bool keep = components == 1 && !d.name.empty();
   if (keep) d.values.reserve(static_cast<size_t>(count));
   // Value v (NaN or infinite: 0.5, not an integer) of the element with tag `tag`, the i-th.
-  auto take = [&](int64_t i, int64_t tag, double v) {
+  auto element_value_take = [&](int64_t i, int64_t tag, double v) {
     if (!keep || !d.integral) return;
     if (v != std::floor(v) || v < INT32_MIN || v > INT32_MAX) {
       d.integral = false;
@@ -463,7 +463,7 @@ void gmsh_element_data_read(GmshNumbers& in, GmshRead& g) {
       for (int64_t c = 0; c < components; ++c) {
         double v;
         std::memcpy(&v, p + 4 + 8 * c, 8);
-        take(i, tag, std::isfinite(v) ? v : 0.5);
+        element_value_take(i, tag, std::isfinite(v) ? v : 0.5);
       }
     }
   } else {
@@ -472,7 +472,7 @@ void gmsh_element_data_read(GmshNumbers& in, GmshRead& g) {
       for (int64_t c = 0; c < components; ++c) {
         double v = 0.5;
         if (!TextCursor::parse_real(text.token("element data value"), v)) v = 0.5;
-        take(i, tag, v);
+        element_value_take(i, tag, v);
       }
     }
   }

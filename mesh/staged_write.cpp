@@ -1,5 +1,8 @@
 #include "mesh/staged_write.hpp"
 
+#include <pthread.h>
+
+#include <chrono>
 #include <ctime>
 #include <filesystem>
 
@@ -17,7 +20,8 @@ double thread_cpu_seconds(clockid_t clock) {
 }
 
 /// `message` with every occurrence of `from` replaced by `to`.
-std::string replaced(std::string message, const std::string& from, const std::string& to) {
+std::string message_with_path_replaced(std::string message, const std::string& from,
+                                       const std::string& to) {
   for (size_t at = message.find(from); at != std::string::npos; at = message.find(from, at))
     message.replace(at, from.size(), to), at += to.size();
   return message;
@@ -64,9 +68,9 @@ void StagedMeshWrite::finish() {
   try {
     std::rethrow_exception(error_);
   } catch (const InputError& e) {
-    throw InputError(replaced(e.what(), staging_, path_));
+    throw InputError(message_with_path_replaced(e.what(), staging_, path_));
   } catch (const OperationError& e) {
-    throw OperationError(replaced(e.what(), staging_, path_));
+    throw OperationError(message_with_path_replaced(e.what(), staging_, path_));
   }
 }
 

@@ -8,9 +8,7 @@
 /// file the verdict refused. The mesh and options must stay unchanged and alive until finish()
 /// or destruction: the writer reads them while the caller may only read them too.
 
-#include <pthread.h>
 #include <atomic>
-#include <chrono>
 #include <exception>
 #include <string>
 #include <thread>
@@ -38,8 +36,9 @@ class StagedMeshWrite {
   void finish();
   /// After finish(): renames the staging file to `path` (OperationError naming `path` on failure).
   void commit();
-  double seconds() const { return seconds_; }          ///< the writer's wall time
-  double cpu_seconds() const { return cpu_seconds_; }  ///< the writer thread's CPU time
+  /// After finish(): the writer's wall time and its thread's CPU time.
+  double seconds() const { return seconds_; }
+  double cpu_seconds() const { return cpu_seconds_; }
 
  private:
   std::string path_, staging_;

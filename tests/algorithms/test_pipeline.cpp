@@ -2,8 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
+#include "mesh/error.hpp"
 #include "mesh/generators.hpp"
+#include "mesh/io.hpp"
 #include "mesh/quality.hpp"
+#include "tests/cli_runner.hpp"
 
 namespace hexrefine {
 namespace {
@@ -11,6 +16,33 @@ namespace {
 // One target in the middle of a 5x5x5 brick of unit cubes, whose corner hex (far from the
 // refined region) is distorted below the 1-13 template's 0.3077: the mesh-wide minimum is that
 // untouched hex, the children's minimum the template's own value, for both refiners.
+TEST(Pipeline, WriteErrorsNameTheOutputNotTheInput) {
+  // The writer refuses a cell field with the wrong number of values: its InputError names the
+  // output only, whether it wrote beside the check (two threads) or after it (one); nothing is
+  // left in the folder but the input.
+  const auto dir = test_temp_dir("pipeline_write_error");
+  const std::string in = (dir / "in.vtu").string(), out = (dir / "out.vtu").string();
+  BrickParams p;
+  p.dims = {3, 3, 3};
+  mesh_write(in, generate_brick(p));
+  for (int threads : {1, 2}) {
+    PipelineOptions o;
+    o.select = {"all"};
+    o.refine.threads = threads;
+    o.write.cell_scalars = {{"q", {1.0}}};
+    try {
+      pipeline_run_files(in, out, o);
+      FAIL() << "wrote a field of one value for 729 hexes";
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind(out + ": cell field 'q' has 1 values", 0), 0u) << message;
+    }
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir),
+                            std::filesystem::directory_iterator()),
+              1);
+  }
+}
+
 TEST(Pipeline, ChildrenMinimumLeavesOutUntouchedInputHexes) {
   const std::array<int, 3> dims{5, 5, 5};
   HexMesh m = generate_brick({.dims = dims, .size = {5, 5, 5}});

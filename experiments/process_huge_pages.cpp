@@ -13,7 +13,8 @@ namespace {
 
 constexpr const char* hugetlb_tunable = "glibc.malloc.hugetlb";
 
-bool running_under_valgrind() {
+// Unused where the sanitizers compile the re-execution out.
+[[maybe_unused]] bool running_under_valgrind() {
   const char* preload = std::getenv("LD_PRELOAD");
   return preload != nullptr && std::strstr(preload, "vgpreload") != nullptr;
 }

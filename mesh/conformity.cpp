@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <numeric>
 #include <string>
@@ -55,7 +56,7 @@ class QuadGrid {
         }
         const Eigen::Vector3d grow = Eigen::Vector3d::Constant(tolerances[i]);
         // find()'s box test: a little wider than the tolerance, so that rounding in
-        // quad_distance never makes it refuse a quad the distance would accept.
+        // quad_within never makes it refuse a quad the test would accept.
         // Rounding grows with the coordinates too (meshes far from the origin).
         const double magnitude = std::max(qlo.cwiseAbs().maxCoeff(), qhi.cwiseAbs().maxCoeff());
         const Eigen::Vector3d margin =
@@ -112,7 +113,7 @@ class QuadGrid {
       // farther than the tolerance, and most quads of a cell are rejected without projecting.
       if ((p.array() < box_lo_[i].array()).any() || (p.array() > box_hi_[i].array()).any())
         continue;
-      if (quad_distance(quads_[i], p) <= tolerances_[i] && visit(i)) return true;
+      if (quad_within(quads_[i], p, tolerances_[i]) && visit(i)) return true;
     }
     return false;
   }
@@ -208,7 +209,7 @@ bool face_lies_across_reference(const Quad& q, const QuadGrid& grid,
   const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
   const double chord = mesh_check_across_chord * quad_diameter(q);
   const auto near = [&](int32_t j) {
-    return quad_distance(reference.quads[j], centroid) <= reference.tolerances[j] + chord;
+    return quad_within(reference.quads[j], centroid, reference.tolerances[j] + chord);
   };
   if (grid.visit_cell(centroid, near)) return true;
   for (const Eigen::Vector3d& c : q)
@@ -243,7 +244,8 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
       std::max({1.6180339887 * extent / std::cbrt(static_cast<double>(n)), 4.0 * tolerance,
                 extent / double(1 << 20), std::numeric_limits<double>::min() * 1e10});
   const Eigen::Vector3d origin = lo - Eigen::Vector3d::Constant(0.3819660113 * cell);
-  // At most cbrt(n) / 1.618 + 2 cells per axis by the cell size above, so about n / 4 cells.
+  // At most cbrt(n) / 1.618 + 2 cells per axis by the cell size above, so about n / 4 cells:
+  // cell ids fit 32 bits for any 32-bit node count.
   std::array<int64_t, 3> dims;
   for (int d = 0; d < 3; ++d)
     dims[d] = std::clamp<int64_t>(static_cast<int64_t>((hi[d] - origin[d]) / cell) + 1, 1,
@@ -255,22 +257,43 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   auto cell_of = [&](int64_t x, int64_t y, int64_t z) { return (z * dims[1] + y) * dims[0] + x; };
   const int64_t cells = dims[0] * dims[1] * dims[2];
   constexpr int64_t chunk_points = 1 << 12;
-  std::vector<int64_t> cell_of_point(n);
-  parallel_chunks(threads, n, chunk_points, [&](int64_t, int64_t begin, int64_t end) {
+  // Both index arrays are written in full before they are read: no zero fill (fresh pages cost
+  // more to touch than to compute here).
+  std::unique_ptr<uint32_t[]> cell_of_point(new uint32_t[n]);
+  // The cell of p in k, and for each axis whether p lies within the tolerance of the cell's lower
+  // (low = -1) or upper (high = 1) wall toward another cell; returns whether it does on any axis.
+  auto point_cell = [&](const Eigen::Vector3d& p, int64_t k[3], int low[3], int high[3]) {
+    bool near_wall = false;
+    for (int d = 0; d < 3; ++d) {
+      k[d] = cell_index(p[d], d);
+      const double wall = origin[d] + static_cast<double>(k[d]) * cell;
+      low[d] = k[d] > 0 && p[d] - wall <= tolerance ? -1 : 0;
+      high[d] = k[d] + 1 < dims[d] && wall + cell - p[d] <= tolerance ? 1 : 0;
+      near_wall = near_wall || low[d] || high[d];
+    }
+    return near_wall;
+  };
+  // Points near a wall (few: the cell size is chosen so) are listed per chunk as they are seen.
+  std::vector<std::vector<int32_t>> near_wall(
+      static_cast<size_t>(parallel_chunk_count(n, chunk_points)));
+  parallel_chunks(threads, n, chunk_points, [&](int64_t chunk, int64_t begin, int64_t end) {
     for (int64_t i = begin; i < end; ++i) {
-      const Eigen::Vector3d& p = mesh.points[i];
-      cell_of_point[i] = cell_of(cell_index(p[0], 0), cell_index(p[1], 1), cell_index(p[2], 2));
+      int64_t k[3];
+      int low[3], high[3];
+      if (point_cell(mesh.points[i], k, low, high))
+        near_wall[chunk].push_back(static_cast<int32_t>(i));
+      cell_of_point[i] = static_cast<uint32_t>(cell_of(k[0], k[1], k[2]));
     }
   });
   std::vector<uint32_t> cell_end(static_cast<size_t>(cells), 0);  // counts, starts, then ends
-  for (int64_t c : cell_of_point) ++cell_end[c];
+  for (int32_t i = 0; i < n; ++i) ++cell_end[cell_of_point[i]];
   uint32_t running = 0;
   for (uint32_t& c : cell_end) {
     const uint32_t count = c;
     c = running;
     running += count;
   }
-  std::vector<int32_t> sorted(n);
+  std::unique_ptr<int32_t[]> sorted(new int32_t[n]);
   for (int32_t i = 0; i < n; ++i) sorted[cell_end[cell_of_point[i]]++] = i;
   auto cell_begin = [&](int64_t c) { return c == 0 ? uint32_t{0} : cell_end[c - 1]; };
 
@@ -286,29 +309,22 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
       for (uint32_t a = cell_begin(c); a < cell_end[c]; ++a)
         for (uint32_t b = a + 1; b < cell_end[c]; ++b) compare(sorted[a], sorted[b]);
   });
-  parallel_chunks(threads, n, chunk_points, [&](int64_t, int64_t begin, int64_t end) {
-    for (int32_t i = static_cast<int32_t>(begin); i < end; ++i) {
-      const Eigen::Vector3d& p = mesh.points[i];
-      int64_t k[3];
-      int low[3], high[3];
-      bool near_wall = false;
-      for (int d = 0; d < 3; ++d) {
-        k[d] = cell_index(p[d], d);
-        const double wall = origin[d] + static_cast<double>(k[d]) * cell;
-        low[d] = k[d] > 0 && p[d] - wall <= tolerance ? -1 : 0;
-        high[d] = k[d] + 1 < dims[d] && wall + cell - p[d] <= tolerance ? 1 : 0;
-        near_wall = near_wall || low[d] || high[d];
-      }
-      if (!near_wall) continue;
-      for (int dz = low[2]; dz <= high[2]; ++dz)
-        for (int dy = low[1]; dy <= high[1]; ++dy)
-          for (int dx = low[0]; dx <= high[0]; ++dx) {
-            if (dx == 0 && dy == 0 && dz == 0) continue;
-            const int64_t c = cell_of(k[0] + dx, k[1] + dy, k[2] + dz);
-            for (uint32_t b = cell_begin(c); b < cell_end[c]; ++b) compare(i, sorted[b]);
-          }
-    }
-  });
+  parallel_chunks(threads, static_cast<int64_t>(near_wall.size()), 1,
+                  [&](int64_t chunk, int64_t, int64_t) {
+                    for (int32_t i : near_wall[chunk]) {
+                      int64_t k[3];
+                      int low[3], high[3];
+                      point_cell(mesh.points[i], k, low, high);
+                      for (int dz = low[2]; dz <= high[2]; ++dz)
+                        for (int dy = low[1]; dy <= high[1]; ++dy)
+                          for (int dx = low[0]; dx <= high[0]; ++dx) {
+                            if (dx == 0 && dy == 0 && dz == 0) continue;
+                            const int64_t c = cell_of(k[0] + dx, k[1] + dy, k[2] + dz);
+                            for (uint32_t b = cell_begin(c); b < cell_end[c]; ++b)
+                              compare(i, sorted[b]);
+                          }
+                    }
+                  });
   return std::count(duplicate.begin(), duplicate.end(), 1);
 }
 
@@ -358,13 +374,14 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   std::vector<ChunkSums> sums(static_cast<size_t>(parallel_chunk_count(r.hexes, chunk_hexes)));
   parallel_chunks(threads, r.hexes, chunk_hexes, [&](int64_t chunk, int64_t begin, int64_t end) {
     ChunkSums& s = sums[chunk];
-    std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin));
-    mesh_scaled_jacobians(mesh, static_cast<int32_t>(begin), scaled_jacobians);
+    std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin)),
+        volumes(static_cast<size_t>(end - begin));
+    mesh_scaled_jacobians_and_volumes(mesh, static_cast<int32_t>(begin), scaled_jacobians, volumes);
     for (int32_t h = static_cast<int32_t>(begin); h < end; ++h) {
       const double sj = scaled_jacobians[h - begin];
       s.scaled_jacobian_sum += sj;
       s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
-      s.volume += hex_volume(hex_points(mesh, h));
+      s.volume += volumes[h - begin];
       ++s.histogram[scaled_jacobian_bin(sj)];
       if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
         s.defects.push_back(h);
@@ -419,7 +436,7 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
       const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
       const bool on_reference = grid.find(centroid, [&](int32_t j) {
         for (const Eigen::Vector3d& c : q)
-          if (quad_distance(reference_surface.quads[j], c) > reference_surface.tolerances[j])
+          if (!quad_within(reference_surface.quads[j], c, reference_surface.tolerances[j]))
             return false;
         return true;
       });

@@ -1,6 +1,7 @@
 #include "mesh/hex_face_adjacency.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <string>
 
 #include "mesh/error.hpp"
@@ -17,18 +18,23 @@ int32_t face_lowest_node(const HexCell& c, int lf) {
 }
 
 /// The three nodes of local face lf other than its lowest, ascending: with the lowest node (the
-/// bucket) they identify the face's node set.
-std::array<int32_t, 3> face_other_nodes(const HexCell& c, int lf, int32_t lowest) {
+/// bucket) they identify the face's node set. A five-comparator sorting network of min and max
+/// (no branch to mispredict: the lowest node's place in the face is arbitrary) sorts all four;
+/// the lowest comes first.
+std::array<int32_t, 3> face_other_nodes(const HexCell& c, int lf) {
   const int* fv = hex_faces[lf];
-  std::array<int32_t, 3> o{};
-  int k = 0;
-  for (int i = 0; i < 4; ++i)
-    if (c[fv[i]] != lowest) o[k++] = c[fv[i]];
-  // A three-element sorting network: no call, no loop.
-  if (o[0] > o[1]) std::swap(o[0], o[1]);
-  if (o[1] > o[2]) std::swap(o[1], o[2]);
-  if (o[0] > o[1]) std::swap(o[0], o[1]);
-  return o;
+  int32_t a = c[fv[0]], b = c[fv[1]], d = c[fv[2]], e = c[fv[3]];
+  auto order = [](int32_t& x, int32_t& y) {
+    const int32_t lo = std::min(x, y), hi = std::max(x, y);
+    x = lo;
+    y = hi;
+  };
+  order(a, b);
+  order(d, e);
+  order(a, d);
+  order(b, e);
+  order(b, d);
+  return {b, d, e};
 }
 
 /// The sorted node set of local face lf of c.
@@ -39,18 +45,9 @@ std::array<int32_t, 4> face_node_set(const HexCell& c, int lf) {
   return q;
 }
 
-/// Whether hexes a and b, which share their local faces la and lb (as node sets), form a doublet
-/// counted at that face: they share another face too, and la is the lowest local face of a that
-/// they share. A second shared face holds two nodes of each hex outside the first (an edge of
-/// it, or all four when it is the opposite face), so the hexes' faces opposite la and lb have a
-/// node in common; that test, 16 comparisons, settles almost every face.
-bool faces_make_doublet(const HexCell& a, int la, const HexCell& b, int lb) {
-  const int* oa = hex_faces[hex_opposite_face[la]];
-  const int* ob = hex_faces[hex_opposite_face[lb]];
-  bool common = false;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) common |= a[oa[i]] == b[ob[j]];
-  if (!common) return false;
+/// Whether hexes a and b share two or more faces and la is the lowest local face of a among them
+/// (the slow half of faces_make_doublet, out of line so the fast half inlines).
+[[gnu::noinline]] bool faces_share_another_face(const HexCell& a, int la, const HexCell& b) {
   std::array<std::array<int32_t, 4>, 6> faces_b;
   for (int f = 0; f < 6; ++f) faces_b[f] = face_node_set(b, f);
   int lowest_shared = -1, shared = 0;
@@ -61,6 +58,25 @@ bool faces_make_doublet(const HexCell& a, int la, const HexCell& b, int lb) {
     ++shared;
   }
   return shared >= 2 && lowest_shared == la;
+}
+
+/// Whether hexes a and b, which share their local faces la and lb (as node sets), form a doublet
+/// counted at that face: they share another face too, and la is the lowest local face of a that
+/// they share. A second shared face holds two nodes of each hex outside the first (an edge of
+/// it, or all four when it is the opposite face), so the hexes' faces opposite la and lb have a
+/// node in common; that test, 16 comparisons in four vector compares of b's four nodes rotated
+/// against a's, settles almost every face (it runs once per interior face).
+bool faces_make_doublet(const HexCell& a, int la, const HexCell& b, int lb) {
+  using Four = int32_t __attribute__((vector_size(16)));
+  const int* oa = hex_faces[hex_opposite_face[la]];
+  const int* ob = hex_faces[hex_opposite_face[lb]];
+  const Four x = {a[oa[0]], a[oa[1]], a[oa[2]], a[oa[3]]};
+  const Four y = {b[ob[0]], b[ob[1]], b[ob[2]], b[ob[3]]};
+  const Four equal = (x == y) | (x == __builtin_shufflevector(y, y, 1, 2, 3, 0)) |
+                     (x == __builtin_shufflevector(y, y, 2, 3, 0, 1)) |
+                     (x == __builtin_shufflevector(y, y, 3, 0, 1, 2));
+  if ((equal[0] | equal[1] | equal[2] | equal[3]) == 0) return false;
+  return faces_share_another_face(a, la, b);
 }
 
 }  // namespace
@@ -97,7 +113,9 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
       offsets[p][node] = running;
       running += count;
     }
-  std::vector<uint32_t> slots(running);
+  // Left uninitialised: the scatter writes every entry, so its threads, not a serial zero fill,
+  // are the first to touch these pages (24 bytes per hex, the largest array of the checker).
+  std::unique_ptr<uint32_t[]> slots(new uint32_t[running]);
   parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
     std::vector<uint32_t>& cursor = offsets[p];
     for (int32_t h = part_begin(static_cast<int>(p)); h < part_begin(static_cast<int>(p) + 1); ++h)
@@ -137,9 +155,7 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
       keys.clear();
       for (uint32_t k = first; k < bucket_end[node]; ++k) {
         const uint32_t s = slots[k];
-        keys.push_back({face_other_nodes(mesh.hexes[s / 6], static_cast<int>(s % 6),
-                                         static_cast<int32_t>(node)),
-                        s, false});
+        keys.push_back({face_other_nodes(mesh.hexes[s / 6], static_cast<int>(s % 6)), s, false});
       }
       // Buckets hold a handful of slots (6 on average), so a quadratic match beats sorting and
       // keeps the slots, hence the faces, in ascending order.
@@ -172,7 +188,7 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
       }
     }
   });
-  std::vector<uint32_t>().swap(slots);
+  slots.reset();
   for (int64_t c = 0; c < chunks; ++c) {
     a.boundary_faces.insert(a.boundary_faces.end(), boundary[c].begin(), boundary[c].end());
     a.nonmanifold_faces.insert(a.nonmanifold_faces.end(), nonmanifold[c].begin(),

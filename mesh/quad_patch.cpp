@@ -84,4 +84,19 @@ double quad_distance(const Quad& q, const Eigen::Vector3d& p) {
   return distance;
 }
 
+bool quad_within(const Quad& q, const Eigen::Vector3d& p, double tolerance) {
+  const Eigen::Vector3d r = quad_point(q, 0.5, 0.5) - p;
+  const auto [su, sv] = quad_tangents(q, 0.5, 0.5);
+  const double a = su.dot(su), b = su.dot(sv), c = sv.dot(sv);
+  const double det = a * c - b * b;
+  if (det > 1e-300) {
+    const double gu = su.dot(r), gv = sv.dot(r);
+    const double u = 0.5 - (c * gu - b * gv) / det, v = 0.5 - (a * gv - b * gu) / det;
+    if (u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0 &&
+        (quad_point(q, u, v) - p).norm() <= tolerance)
+      return true;
+  }
+  return quad_distance(q, p) <= tolerance;
+}
+
 }  // namespace hexrefine

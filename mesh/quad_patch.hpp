@@ -51,4 +51,12 @@ QuadProjection quad_closest_point(const Quad& q, const Eigen::Vector3d& p, doubl
 /// patches, where no Newton step is possible, still get an answer).
 double quad_distance(const Quad& q, const Eigen::Vector3d& p);
 
+/// Whether some patch point lies within `tolerance` of p: yes wherever quad_distance(q, p) <=
+/// tolerance, found sooner where it is yes: one Gauss-Newton step from the centre (exact for a
+/// parallelogram, the usual face of a refined mesh) gives a patch point, and if that one is within
+/// the tolerance nothing more is computed; otherwise quad_distance decides. That step can also
+/// find a point quad_distance's clamped Newton missed (it may stop on the patch's border short of
+/// the nearest point, off a skewed quad's side): then the yes is the truer answer.
+bool quad_within(const Quad& q, const Eigen::Vector3d& p, double tolerance);
+
 }  // namespace hexrefine

@@ -124,6 +124,25 @@ Lanes lanes_scaled_jacobian(const std::array<LaneVector, 8>& p) {
   return best;
 }
 
+/// hex_volume lane by lane: Grandy's three triple products, each a.dot(b.cross(c)) in Eigen's
+/// order of operations.
+Lanes lanes_volume(const std::array<LaneVector, 8>& p) {
+  auto d = [&](int a, int b) { return lanes_difference(p[a], p[b]); };
+  auto sum = [](const LaneVector& a, const LaneVector& b) {
+    return LaneVector{a.x + b.x, a.y + b.y, a.z + b.z};
+  };
+  auto triple = [](const LaneVector& a, const LaneVector& b, const LaneVector& c) {
+    const LaneVector cross = {b.y * c.z - b.z * c.y, b.z * c.x - b.x * c.z, b.x * c.y - b.y * c.x};
+    return (a.x * cross.x + a.y * cross.y) + a.z * cross.z;
+  };
+  const LaneVector d70 = d(7, 0), d61 = d(6, 1), d63 = d(6, 3), d20 = d(2, 0), d50 = d(5, 0),
+                   d64 = d(6, 4);
+  const Lanes twelve = {12.0, 12.0};
+  return (triple(sum(d61, d70), d63, d20) + triple(d70, sum(d63, d50), d64) +
+          triple(d61, d50, sum(d64, d20))) /
+         twelve;
+}
+
 /// Corners of hex a in lane 0 and of hex b in lane 1.
 std::array<LaneVector, 8> lanes_corners(const HexCorners& a, const HexCorners& b) {
   std::array<LaneVector, 8> p;
@@ -227,9 +246,11 @@ double hex_volume(const HexCorners& p) {
 
 namespace {
 
-/// out[k] = hex_scaled_jacobian of hex hex_of(k), k < out.size(), two hexes per evaluation.
+/// out[k] = hex_scaled_jacobian of hex hex_of(k), k < out.size(), two hexes per evaluation; and
+/// volumes[k] = its hex_volume when `volumes` is not empty.
 template <class HexOf>
-void scaled_jacobians_in_pairs(const HexMesh& mesh, HexOf hex_of, std::span<double> out) {
+void scaled_jacobians_in_pairs(const HexMesh& mesh, HexOf hex_of, std::span<double> out,
+                               std::span<double> volumes = {}) {
   const size_t count = out.size();
   for (size_t k = 0; k < count; k += 2) {
     const HexCell& a = mesh.hexes[hex_of(k)];
@@ -242,6 +263,10 @@ void scaled_jacobians_in_pairs(const HexMesh& mesh, HexOf hex_of, std::span<doub
     const Lanes pair = lanes_scaled_jacobian(p);
     out[k] = pair[0];
     if (k + 1 < count) out[k + 1] = pair[1];
+    if (volumes.empty()) continue;
+    const Lanes volume = lanes_volume(p);
+    volumes[k] = volume[0];
+    if (k + 1 < count) volumes[k + 1] = volume[1];
   }
 }
 
@@ -250,6 +275,13 @@ void scaled_jacobians_in_pairs(const HexMesh& mesh, HexOf hex_of, std::span<doub
 void mesh_scaled_jacobians(const HexMesh& mesh, int32_t first, std::span<double> out) {
   scaled_jacobians_in_pairs(
       mesh, [&](size_t k) { return first + static_cast<int32_t>(k); }, out);
+}
+
+void mesh_scaled_jacobians_and_volumes(const HexMesh& mesh, int32_t first,
+                                       std::span<double> scaled_jacobians,
+                                       std::span<double> volumes) {
+  scaled_jacobians_in_pairs(
+      mesh, [&](size_t k) { return first + static_cast<int32_t>(k); }, scaled_jacobians, volumes);
 }
 
 void mesh_scaled_jacobians(const HexMesh& mesh, std::span<const int32_t> hexes,

@@ -105,6 +105,13 @@ std::vector<double> mesh_scaled_jacobians(const HexMesh& mesh);
 /// passes). Precondition: mesh_validate_ids holds and the hexes exist.
 void mesh_scaled_jacobians(const HexMesh& mesh, int32_t first, std::span<double> out);
 
+/// mesh_scaled_jacobians(mesh, first, scaled_jacobians) and, from the same corners, hex_volume of
+/// the same hexes into `volumes` (same size), both bit-identical to the per-hex functions: the
+/// checker's pass, which needs both and would otherwise gather every hex's corners twice.
+void mesh_scaled_jacobians_and_volumes(const HexMesh& mesh, int32_t first,
+                                       std::span<double> scaled_jacobians,
+                                       std::span<double> volumes);
+
 /// The same for the listed hexes: out[k] = hex_scaled_jacobian of hex hexes[k] (out.size() ==
 /// hexes.size()), bit-identical to calling it hex by hex.
 void mesh_scaled_jacobians(const HexMesh& mesh, std::span<const int32_t> hexes,

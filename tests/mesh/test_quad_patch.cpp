@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <random>
 
 namespace hexrefine {
 namespace {
@@ -58,6 +60,50 @@ TEST(QuadPatch, WarpedQuad) {
   // The patch passes through its corners and its centre is the mean of them.
   EXPECT_EQ(quad_point(q, 1, 1), q[2]);
   EXPECT_NEAR((quad_point(q, 0.5, 0.5) - Eigen::Vector3d(0.5, 0.5, 0.1)).norm(), 0.0, 1e-15);
+}
+
+TEST(QuadPatch, WithinSaysYesExactlyWhereAPatchPointIsThatClose) {
+  // quad_within never misses a yes of quad_distance, and each of its own yeses names a real
+  // patch point: where quad_distance says no, the patch's dense sampling finds a point within
+  // the tolerance (plus the sampling's spacing). Points on, near and off planar and warped
+  // quads of skewed shapes, at tolerances around their distance.
+  std::mt19937 random(23);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3), where(-0.5, 1.5), height(-0.02, 0.02);
+  auto sampled_distance = [](const Quad& q, const Eigen::Vector3d& p) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= 400; ++i)
+      for (int j = 0; j <= 400; ++j)
+        best = std::min(best, (quad_point(q, i / 400.0, j / 400.0) - p).norm());
+    return best;
+  };
+  int yes = 0, beyond_distance = 0;
+  for (int shape = 0; shape < 100; ++shape) {
+    Quad q = unit_square;
+    for (Eigen::Vector3d& c : q) c += Eigen::Vector3d(jitter(random), jitter(random), 0);
+    if (shape % 2) q[2].z() += jitter(random);  // warped
+    for (int k = 0; k < 20; ++k) {
+      const Eigen::Vector3d p =
+          quad_point(q, where(random), where(random)) + Eigen::Vector3d(0, 0, height(random));
+      const double distance = quad_distance(q, p);
+      for (double tolerance : {0.5 * distance, 0.999 * distance, distance, 2.0 * distance}) {
+        const bool within = quad_within(q, p, tolerance);
+        if (distance <= tolerance) {
+          ASSERT_TRUE(within) << shape << " " << k;
+        }
+        yes += within;
+        if (!within || distance <= tolerance) continue;
+        ++beyond_distance;
+        ASSERT_LE(sampled_distance(q, p), tolerance + 0.01) << shape << " " << k;
+      }
+    }
+  }
+  EXPECT_GE(yes, 4000);             // the distance and twice it, for each of the 2,000 points
+  EXPECT_LT(beyond_distance, 100);  // quad_distance is right almost everywhere
+  // On the unit square: inside at height 0.1, beyond a side by 0.5.
+  EXPECT_TRUE(quad_within(unit_square, Eigen::Vector3d(0.3, 0.6, 0.1), 0.1 + 1e-15));
+  EXPECT_FALSE(quad_within(unit_square, Eigen::Vector3d(0.3, 0.6, 0.1), 0.099));
+  EXPECT_FALSE(quad_within(unit_square, Eigen::Vector3d(1.5, 0.5, 0), 0.49));
+  EXPECT_TRUE(quad_within(unit_square, Eigen::Vector3d(1.5, 0.5, 0), 0.51));
 }
 
 }  // namespace

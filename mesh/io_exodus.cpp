@@ -12,11 +12,17 @@
 #include <exodusII.h>
 #include <netcdf.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <bit>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -331,6 +337,109 @@ HexMesh exodus_read(const std::string& path) {
   return mesh;
 }
 
+namespace {
+
+/// Writes the bulk arrays of a netCDF classic file whose header is complete: each variable's
+/// values, converted to the file's big-endian type, at the offset its header entry gives.
+class ExodusBulkWriter {
+ public:
+  /// Reads the header of `path` (throws OperationError if it is not a classic netCDF file).
+  explicit ExodusBulkWriter(const std::string& path) : path_(path) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+    if (fd_ < 0) throw OperationError(std::string("cannot reopen: ") + std::strerror(errno));
+    const off_t size = ::lseek(fd_, 0, SEEK_END);
+    for (int64_t want = std::min<int64_t>(size, 1 << 20);; want = size) {
+      std::string head(static_cast<size_t>(want), '\0');
+      if (::pread(fd_, head.data(), head.size(), 0) != static_cast<ssize_t>(head.size()))
+        throw OperationError("cannot read back the header");
+      try {
+        if (std::optional<NetcdfClassicLayout> l = netcdf_classic_layout(path, head, size)) {
+          layout_ = std::move(*l);
+          break;
+        }
+      } catch (const InputError& e) {
+        throw OperationError(e.what());
+      }
+      if (want == size) throw OperationError("header longer than the file");
+    }
+  }
+  ~ExodusBulkWriter() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  ExodusBulkWriter(const ExodusBulkWriter&) = delete;
+  ExodusBulkWriter& operator=(const ExodusBulkWriter&) = delete;
+
+  const NetcdfVariableExtent* find(const std::string& name) const {
+    for (const NetcdfVariableExtent& v : layout_.variables)
+      if (v.name == name) return &v;
+    return nullptr;
+  }
+  const NetcdfVariableExtent& need(const std::string& name) const {
+    if (const NetcdfVariableExtent* v = find(name)) return *v;
+    throw OperationError("no variable " + name + " in the header just written");
+  }
+
+  /// Values value_of(0 .. count - 1) into entries first .. first + count - 1 of `v` (of the
+  /// first record, for a record variable).
+  template <class ValueOf>
+  void put(const NetcdfVariableExtent& v, size_t first, size_t count, ValueOf value_of) {
+    const size_t width = v.type == NC_DOUBLE || v.type == NC_INT64 ? 8 : 4;
+    if (v.type != NC_DOUBLE && v.type != NC_FLOAT && v.type != NC_INT && v.type != NC_INT64)
+      throw OperationError("variable " + v.name + " of netCDF type " + std::to_string(v.type));
+    if ((first + count) * width > v.size)
+      throw OperationError("variable " + v.name + " holds " + std::to_string(v.size) +
+                           " bytes, not " + std::to_string((first + count) * width));
+    for (size_t begin = 0; begin < count; begin += exodus_chunk) {
+      const size_t end = std::min(count, begin + exodus_chunk);
+      buffer_.resize((end - begin) * width);
+      unsigned char* out = buffer_.data();
+      for (size_t k = begin; k < end; ++k, out += width) {
+        const auto value = value_of(k);
+        if (v.type == NC_DOUBLE)
+          store_big_endian(std::bit_cast<uint64_t>(static_cast<double>(value)), out, 8);
+        else if (v.type == NC_FLOAT)
+          store_big_endian(std::bit_cast<uint32_t>(static_cast<float>(value)), out, 4);
+        else if (v.type == NC_INT64)
+          store_big_endian(static_cast<uint64_t>(static_cast<int64_t>(value)), out, 8);
+        else
+          store_big_endian(static_cast<uint32_t>(static_cast<int32_t>(value)), out, 4);
+      }
+      write_at(v.begin + (first + begin) * width);
+    }
+  }
+
+  void close() {
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) throw OperationError(std::string("close: ") + std::strerror(errno));
+  }
+
+ private:
+  static void store_big_endian(uint64_t bits, unsigned char* out, size_t width) {
+    for (size_t i = 0; i < width; ++i)
+      out[i] = static_cast<unsigned char>(bits >> (8 * (width - 1 - i)));
+  }
+  void write_at(uint64_t offset) {
+    const unsigned char* data = buffer_.data();
+    size_t left = buffer_.size();
+    while (left > 0) {
+      const ssize_t wrote = ::pwrite(fd_, data, left, static_cast<off_t>(offset));
+      if (wrote <= 0) {
+        if (wrote < 0 && errno == EINTR) continue;
+        throw OperationError(std::string("write (disk full?): ") + std::strerror(errno));
+      }
+      data += wrote, offset += static_cast<uint64_t>(wrote), left -= static_cast<size_t>(wrote);
+    }
+  }
+
+  std::string path_;
+  int fd_ = -1;
+  NetcdfClassicLayout layout_;
+  std::vector<unsigned char> buffer_;
+};
+
+}  // namespace
+
 void exodus_write(const std::string& path, const HexMesh& mesh,
                   const std::vector<std::pair<std::string, std::vector<double>>>& cell_scalars) {
   const size_t m = mesh.hexes.size(), n = mesh.points.size();
@@ -347,6 +456,19 @@ void exodus_write(const std::string& path, const HexMesh& mesh,
     std::remove(tmp.c_str());
     throw OperationError(path + ": cannot write Exodus II file: " + what);
   };
+  // Element variables (one time step): every attribute but block_id (the blocks hold it),
+  // then the cell scalars, by block in the order of the blocks.
+  struct Field {
+    std::string name;
+    const std::vector<int32_t>* integers;
+    const std::vector<double>* reals;
+    double operator[](size_t h) const { return integers ? (*integers)[h] : (*reals)[h]; }
+  };
+  std::vector<Field> fields;
+  for (const HexAttribute& a : mesh.attributes)
+    if (a.name != attribute_block_id) fields.push_back({a.name, &a.values, nullptr});
+  for (const auto& s : cell_scalars) fields.push_back({s.first, nullptr, &s.second});
+  if (m == 0) fields.clear();
   ex_opts(EX_DEFAULT);
   {
     int comp_ws = 8, io_ws = 8;
@@ -395,19 +517,6 @@ void exodus_write(const std::string& path, const HexMesh& mesh,
           failed("name of element block " + std::to_string(b));
       }
     }
-    // Element variables (one time step): every attribute but block_id (the blocks hold it),
-    // then the cell scalars, by block in the order of the blocks.
-    struct Field {
-      std::string name;
-      const std::vector<int32_t>* integers;
-      const std::vector<double>* reals;
-      double operator[](size_t h) const { return integers ? (*integers)[h] : (*reals)[h]; }
-    };
-    std::vector<Field> fields;
-    for (const HexAttribute& a : mesh.attributes)
-      if (a.name != attribute_block_id) fields.push_back({a.name, &a.values, nullptr});
-    for (const auto& s : cell_scalars) fields.push_back({s.first, nullptr, &s.second});
-    if (m == 0) fields.clear();
     if (!fields.empty()) {
       size_t longest = 0;
       for (const Field& f : fields) longest = std::max(longest, f.name.size());
@@ -426,66 +535,50 @@ void exodus_write(const std::string& path, const HexMesh& mesh,
                              static_cast<int>(fields.size()), truth.data()) < 0)
         failed("element variable truth table");
     }
-    // The element id map is defined at its first write: written before the other bulk data.
-    // Bulk data goes out in chunks through reused buffers: one buffer per array of the whole
-    // mesh would fault in about as much fresh memory as the mesh holds.
-    std::vector<int64_t> map;
-    for (size_t begin = 0; begin < m; begin += exodus_chunk) {
-      const size_t end = std::min(m, begin + exodus_chunk);
-      map.clear();
-      for (size_t k = begin; k < end; ++k) map.push_back(int64_t{order[k]} + 1);
-      if (ex_put_partial_id_map(file.id, EX_ELEM_MAP, static_cast<int64_t>(begin + 1),
-                                static_cast<int64_t>(end - begin), map.data()) < 0)
-        failed("element id map");
+    // The element id map is defined at its first write, so its first entry is written here;
+    // the time step makes the one record of the element variables. The rest of the bulk data
+    // goes in below, once the library has closed the file.
+    if (m > 0) {
+      const int64_t first = int64_t{order[0]} + 1;
+      if (ex_put_partial_id_map(file.id, EX_ELEM_MAP, 1, 1, &first) < 0) failed("element id map");
     }
     if (!fields.empty()) {
       const double time = 0.0;
       if (ex_put_time(file.id, 1, &time) < 0) failed("time step");
     }
-    std::vector<double> x, y, z;
-    for (size_t begin = 0; begin < n; begin += exodus_chunk) {
-      const size_t end = std::min(n, begin + exodus_chunk);
-      x.resize(end - begin), y.resize(end - begin), z.resize(end - begin);
-      for (size_t i = begin; i < end; ++i)
-        x[i - begin] = mesh.points[i].x(), y[i - begin] = mesh.points[i].y(),
-              z[i - begin] = mesh.points[i].z();
-      if (ex_put_partial_coord(file.id, static_cast<int64_t>(begin + 1),
-                               static_cast<int64_t>(end - begin), x.data(), y.data(), z.data()) < 0)
-        failed("coordinates");
-    }
-    std::vector<int32_t> conn;
-    for (size_t bi = 0; bi < blocks.size(); ++bi) {
-      const int64_t b = blocks[bi];
-      // The library has no partial connectivity writer: its variable (connect<block index>,
-      // 1-based in file order) is written through netCDF, chunk by chunk.
-      int conn_id = -1;
-      if (nc_inq_varid(file.id, ("connect" + std::to_string(bi + 1)).c_str(), &conn_id) != NC_NOERR)
-        failed("connectivity variable of element block " + std::to_string(b));
-      for (size_t begin = block_first[bi]; begin < block_first[bi + 1]; begin += exodus_chunk) {
-        const size_t end = std::min(block_first[bi + 1], begin + exodus_chunk);
-        conn.clear();
-        for (size_t k = begin; k < end; ++k)
-          for (int32_t v : mesh.hexes[order[k]]) conn.push_back(v + 1);
-        const size_t start[2] = {begin - block_first[bi], 0}, count[2] = {end - begin, 8};
-        if (nc_put_vara_int(file.id, conn_id, start, count, conn.data()) != NC_NOERR)
-          failed("connectivity of element block " + std::to_string(b));
-      }
-    }
-    std::vector<double> values;
-    for (size_t bi = 0; bi < blocks.size(); ++bi)
-      for (size_t f = 0; f < fields.size(); ++f)
-        for (size_t begin = block_first[bi]; begin < block_first[bi + 1]; begin += exodus_chunk) {
-          const size_t end = std::min(block_first[bi + 1], begin + exodus_chunk);
-          values.clear();
-          for (size_t k = begin; k < end; ++k) values.push_back(fields[f][order[k]]);
-          if (ex_put_partial_var(file.id, 1, EX_ELEM_BLOCK, static_cast<int>(f + 1), exodus_ids[bi],
-                                 static_cast<int64_t>(begin - block_first[bi] + 1),
-                                 static_cast<int64_t>(end - begin), values.data()) < 0)
-            failed("element variable " + fields[f].name);
-        }
     const int id = file.id;
     file.id = -1;
     if (ex_close(id) < 0) failed("close (disk full?)");
+  }
+  // The bulk arrays, straight into the places the header gives them. Through the library they
+  // went in 8 KB blocks, each read from the file before it was written (118,000 reads of holes,
+  // which the kernel zero-fills: 0.67 GB read and 0.96 GB written for an 11.4 M-hex mesh, 2 CPU
+  // seconds); here they are converted to big-endian (netCDF's byte order) in 1 M-entry chunks
+  // and written with one pwrite each.
+  try {
+    ExodusBulkWriter bulk(tmp);
+    for (const char* axis : {"x", "y", "z"}) {
+      const int d = axis[0] - 'x';
+      if (const NetcdfVariableExtent* v = bulk.find(std::string("coord") + axis))
+        bulk.put(*v, 0, n, [&](size_t i) { return mesh.points[i][d]; });
+      else if (const NetcdfVariableExtent* all = bulk.find("coord"))  // one (dim, node) array
+        bulk.put(*all, static_cast<size_t>(d) * n, n, [&](size_t i) { return mesh.points[i][d]; });
+      else if (n > 0)
+        throw OperationError("no coordinate variable");
+    }
+    for (size_t bi = 0; bi < blocks.size(); ++bi) {
+      const size_t first = groups.starts[bi], count = groups.starts[bi + 1] - first;
+      bulk.put(bulk.need("connect" + std::to_string(bi + 1)), 0, 8 * count,
+               [&](size_t k) { return int64_t{mesh.hexes[order[first + k / 8]][k % 8]} + 1; });
+      for (size_t f = 0; f < fields.size(); ++f)
+        bulk.put(bulk.need("vals_elem_var" + std::to_string(f + 1) + "eb" + std::to_string(bi + 1)),
+                 0, count, [&](size_t k) { return fields[f][order[first + k]]; });
+    }
+    if (m > 0)
+      bulk.put(bulk.need("elem_num_map"), 0, m, [&](size_t k) { return int64_t{order[k]} + 1; });
+    bulk.close();
+  } catch (const OperationError& e) {
+    failed(e.what());
   }
   file_commit_temporary(tmp, path);
 }

@@ -19,8 +19,9 @@ bool netcdf_type_is_number(nc_type type) {
 
 }  // namespace
 
-bool netcdf_classic_header_check(const std::string& path, std::string_view bytes,
-                                 int64_t file_size) {
+std::optional<NetcdfClassicLayout> netcdf_classic_layout(const std::string& path,
+                                                         std::string_view bytes,
+                                                         int64_t file_size) {
   const int version = bytes[3];
   const size_t count_size = version == 5 ? 8 : 4;  // NON_NEG: nelems, lengths, dimids
   size_t pos = 4;
@@ -62,11 +63,13 @@ bool netcdf_classic_header_check(const std::string& path, std::string_view bytes
     if (!need(padded)) return;
     pos += static_cast<size_t>(padded);
   };
-  auto name = [&] {
+  auto name = [&]() -> std::string {
     const uint64_t n = count("name length", 1);
-    if (truncated) return;
+    if (truncated) return {};
     if (n > 4096) fail("name of " + std::to_string(n) + " bytes");
+    const size_t at = pos;
     skip_padded(n, "name");
+    return truncated ? std::string() : std::string(bytes.substr(at, static_cast<size_t>(n)));
   };
   auto type_size = [&](uint64_t type) -> uint64_t {
     switch (type) {
@@ -119,14 +122,11 @@ bool netcdf_classic_header_check(const std::string& path, std::string_view bytes
   const uint64_t var_tag = number(4, "variable list tag");
   const uint64_t vars = count("variable count", 24);
   if (!truncated && var_tag != 0x0B && !(var_tag == 0 && vars == 0)) fail("bad variable list tag");
-  // Where each variable's data ends (record variables: in the first record).
-  struct Extent {
-    uint64_t begin, size;
-    bool record;
-  };
-  std::vector<Extent> extents;
+  NetcdfClassicLayout layout;
+  layout.version = version;
+  layout.records = records;
   for (uint64_t i = 0; i < vars && !truncated; ++i) {
-    name();
+    std::string variable = name();
     const uint64_t rank = count("variable rank", count_size);
     bool record = false;
     for (uint64_t k = 0; k < rank && !truncated; ++k) {
@@ -138,19 +138,30 @@ bool netcdf_classic_header_check(const std::string& path, std::string_view bytes
     if (truncated) break;
     attributes();
     if (truncated) break;
-    type_size(number(4, "variable type"));
+    const uint64_t type = number(4, "variable type");
+    type_size(type);
     const uint64_t size = number(count_size, "variable size");
     const uint64_t begin = number(version == 1 ? 4 : 8, "variable offset");
-    extents.push_back({begin, size, record});
+    layout.variables.push_back({std::move(variable), static_cast<int>(type), begin, size, record});
   }
-  if (truncated) return false;
+  if (truncated) return std::nullopt;
+  return layout;
+}
+
+bool netcdf_classic_header_check(const std::string& path, std::string_view bytes,
+                                 int64_t file_size) {
+  const std::optional<NetcdfClassicLayout> layout = netcdf_classic_layout(path, bytes, file_size);
+  if (!layout) return false;
+  const uint64_t count_size = layout->version == 5 ? 8 : 4;
+  const uint64_t records = layout->records;
+  const std::vector<NetcdfVariableExtent>& extents = layout->variables;
   // Every variable's data inside the file: a truncated file is refused here, not read as the
   // netCDF library's zeros or fill values. Record variables repeat every record size bytes.
   uint64_t record_size = 0;
-  for (const Extent& e : extents)
+  for (const NetcdfVariableExtent& e : extents)
     if (e.record) record_size += e.size;
   const bool streaming = count_size == 4 && records == 0xFFFFFFFFu;
-  for (const Extent& e : extents) {
+  for (const NetcdfVariableExtent& e : extents) {
     if (e.size > static_cast<uint64_t>(file_size))
       throw InputError(path + ": netCDF variable of " + std::to_string(e.size) +
                        " bytes larger than the file (" + std::to_string(file_size) + " bytes)");

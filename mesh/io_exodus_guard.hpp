@@ -8,8 +8,11 @@
 
 #include <netcdf.h>
 
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace hexrefine::io_detail {
 
@@ -20,6 +23,29 @@ struct NetcdfFile {
     if (id >= 0) nc_close(id);
   }
 };
+
+/// Where a netCDF classic file keeps one variable's data: its name, netCDF type (NC_INT, ...),
+/// offset of its first byte and size in bytes (of one record for a record variable).
+struct NetcdfVariableExtent {
+  std::string name;
+  int type = 0;
+  uint64_t begin = 0, size = 0;
+  bool record = false;
+};
+
+/// The header of a netCDF classic file: format version (1, 2 or 5), record count and the
+/// variables in file order.
+struct NetcdfClassicLayout {
+  int version = 0;
+  uint64_t records = 0;
+  std::vector<NetcdfVariableExtent> variables;
+};
+
+/// Walks the header of a netCDF classic file (see netcdf_classic_header_check, which calls it)
+/// and returns its layout; nullopt when the header runs past `bytes` but not past `file_size`.
+/// Throws InputError naming `path` when it is malformed.
+std::optional<NetcdfClassicLayout> netcdf_classic_layout(const std::string& path,
+                                                         std::string_view bytes, int64_t file_size);
 
 /// Walks the header of a netCDF classic file (CDF-1, CDF-2 or CDF-5: magic, record count, then
 /// the dimension, global attribute and variable lists, each "tag, count, entries") and checks

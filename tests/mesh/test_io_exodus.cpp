@@ -1,9 +1,14 @@
 #include <gtest/gtest.h>
+#include <netcdf.h>
+
+#include <algorithm>
+#include <bit>
 
 #include "cli_runner.hpp"
 #include "io_test_support.hpp"
 #include "mesh/error.hpp"
 #include "mesh/io.hpp"
+#include "mesh/io_exodus_guard.hpp"
 
 namespace hexrefine {
 namespace {
@@ -52,6 +57,67 @@ TEST(IoExodus, HeaderSpaceIsReservedSoDefinitionsMoveNoData) {
   EXPECT_GE(begin, 65536u);
   EXPECT_LT(begin, bytes.size());
   EXPECT_EQ(mesh_read(path).hex_count(), io_test_brick().hex_count());
+}
+
+// The bulk arrays are written by hexrefine itself at the offsets of the header the library
+// wrote (netCDF classic, big-endian): every variable lies inside the file, in file order
+// without overlap, and the raw bytes hold the values, checked here without the library.
+TEST(IoExodus, BulkDataLiesWhereTheHeaderSaysInBigEndian) {
+  const auto dir = test_temp_dir("io_exodus_bulk");
+  HexMesh m = io_test_brick();
+  MeshWriteOptions o;
+  std::vector<double> field(m.hexes.size());
+  for (size_t h = 0; h < field.size(); ++h) field[h] = 0.5 + static_cast<double>(h) / 3.0;
+  o.cell_scalars.push_back({"scaled_jacobian", field});
+  const std::string path = (dir / "bulk.e").string();
+  mesh_write(path, m, o);
+  const std::string bytes = test_file_text(path);
+  const auto layout =
+      io_detail::netcdf_classic_layout(path, bytes, static_cast<int64_t>(bytes.size()));
+  ASSERT_TRUE(layout.has_value());
+  EXPECT_EQ(layout->records, 1u);  // one time step of element variables
+  // The scalar field is the last element variable: after every attribute but block_id.
+  const std::string values_name = "vals_elem_var" + std::to_string(m.attributes.size()) + "eb1";
+  std::vector<io_detail::NetcdfVariableExtent> variables = layout->variables;
+  std::sort(variables.begin(), variables.end(),
+            [](const auto& a, const auto& b) { return a.begin < b.begin; });
+  uint64_t previous_end = 0;
+  const io_detail::NetcdfVariableExtent* coordx = nullptr;
+  const io_detail::NetcdfVariableExtent* connect = nullptr;
+  const io_detail::NetcdfVariableExtent* values = nullptr;
+  for (const io_detail::NetcdfVariableExtent& v : variables) {
+    EXPECT_GE(v.begin, previous_end) << v.name;
+    EXPECT_LE(v.begin + v.size, bytes.size()) << v.name;
+    previous_end = v.begin + v.size;
+    if (v.name == "coordx") coordx = &v;
+    if (v.name == "connect1") connect = &v;
+    if (v.name == values_name) values = &v;
+  }
+  EXPECT_EQ(previous_end, bytes.size());  // the last record variable ends the file
+  ASSERT_NE(coordx, nullptr);
+  ASSERT_NE(connect, nullptr);
+  ASSERT_NE(values, nullptr);
+  auto big_endian = [&](uint64_t at, int width) {
+    uint64_t v = 0;
+    for (int k = 0; k < width; ++k) v = v << 8 | static_cast<unsigned char>(bytes.at(at + k));
+    return v;
+  };
+  ASSERT_EQ(coordx->type, NC_DOUBLE);
+  for (int32_t i = 0; i < m.point_count(); ++i)
+    ASSERT_EQ(std::bit_cast<double>(big_endian(coordx->begin + 8 * i, 8)), m.points[i].x()) << i;
+  ASSERT_EQ(connect->type, NC_INT);
+  // One block (block_id 1 for the first hexes, see io_test_brick): its hexes in hex order.
+  const std::vector<int32_t>& block = *mesh_find_attribute(m, attribute_block_id);
+  std::vector<int32_t> first_block;
+  for (int32_t h = 0; h < m.hex_count(); ++h)
+    if (block[h] == block[0]) first_block.push_back(h);
+  for (size_t k = 0; k < first_block.size(); ++k)
+    for (int v = 0; v < 8; ++v)
+      ASSERT_EQ(big_endian(connect->begin + 4 * (8 * k + v), 4),
+                static_cast<uint64_t>(m.hexes[first_block[k]][v] + 1));
+  ASSERT_EQ(values->type, NC_DOUBLE);
+  for (size_t k = 0; k < first_block.size(); ++k)
+    ASSERT_EQ(std::bit_cast<double>(big_endian(values->begin + 8 * k, 8)), field[first_block[k]]);
 }
 
 TEST(IoExodus, ParentHexIsAnElementVariableAndFloatFieldsAreNotAttributes) {

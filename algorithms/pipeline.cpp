@@ -2,6 +2,7 @@
 
 #include <sys/resource.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -11,6 +12,7 @@
 #include <sstream>
 
 #include "mesh/error.hpp"
+#include "mesh/parallel.hpp"
 #include "mesh/quality.hpp"
 #include "mesh/selection.hpp"
 #include "mesh/staged_write.hpp"
@@ -182,11 +184,19 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     const std::vector<int32_t>* level = mesh_find_attribute(r.mesh, attribute_refinement_level);
     const std::vector<int32_t>* input_level =
         mesh_find_attribute(input, attribute_refinement_level);
+    // Both passes over the output on every thread (a parent marked by two threads gets the
+    // same 1 from each).
+    const int threads = o.refine.threads;
+    constexpr int64_t chunk_hexes = 1 << 16;
     std::vector<uint8_t> refined(input.hexes.size(), 0);
-    for (int32_t h = 0; parent && level && h < r.mesh.hex_count(); ++h) {
-      const int32_t p = (*parent)[h];
-      if ((*level)[h] > (input_level ? (*input_level)[p] : 0)) refined[p] = 1;
-    }
+    if (parent && level)
+      parallel_chunks(threads, r.mesh.hex_count(), chunk_hexes, [&](int64_t, int64_t b, int64_t e) {
+        for (int64_t h = b; h < e; ++h) {
+          const int32_t p = (*parent)[h];
+          if ((*level)[h] > (input_level ? (*input_level)[p] : 0))
+            std::atomic_ref<uint8_t>(refined[p]).store(1, std::memory_order_relaxed);
+        }
+      });
     for (int32_t h = 0; h < input.hex_count(); ++h)
       if (refined[h]) {
         ++r.refined_parents;
@@ -194,8 +204,16 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
                                                          hex_scaled_jacobian(hex_points(input, h)));
       }
     is_child.resize(r.mesh.hexes.size(), 0);
-    for (int32_t h = 0; parent && level && h < r.mesh.hex_count(); ++h)
-      children += is_child[h] = refined[(*parent)[h]];
+    if (parent && level) {
+      std::vector<int64_t> chunk_children(
+          static_cast<size_t>(parallel_chunk_count(r.mesh.hex_count(), chunk_hexes)), 0);
+      parallel_chunks(threads, r.mesh.hex_count(), chunk_hexes,
+                      [&](int64_t chunk, int64_t b, int64_t e) {
+                        for (int64_t h = b; h < e; ++h)
+                          chunk_children[chunk] += is_child[h] = refined[(*parent)[h]];
+                      });
+      for (int64_t c : chunk_children) children += c;
+    }
   }
   // The minimum over the children: the checker's own when every hex is one (a full refinement,
   // where a second pass would cost as much as the checker's quality samples), else a pass over

@@ -151,22 +151,27 @@ struct BoundarySurface {
   std::vector<double> tolerances;  ///< surface tolerance x diameter, per face
 };
 
-BoundarySurface boundary_surface(const HexMesh& mesh, std::vector<HexFaceSlot> slots) {
+BoundarySurface boundary_surface(const HexMesh& mesh, std::vector<HexFaceSlot> slots,
+                                 int threads = 1) {
   BoundarySurface s;
   s.slots = std::move(slots);
-  s.nodes.reserve(s.slots.size());
-  s.quads.reserve(s.slots.size());
-  for (const HexFaceSlot& slot : s.slots) {
-    const HexCell& c = mesh.hexes[slot.hex];
-    const int* fv = hex_faces[slot.local_face];
-    const std::array<int32_t, 4> n = {c[fv[0]], c[fv[1]], c[fv[2]], c[fv[3]]};
-    s.nodes.push_back(n);
-    s.quads.push_back({mesh.points[n[0]], mesh.points[n[1]], mesh.points[n[2]], mesh.points[n[3]]});
-    // A point averaged from patch points (a sub-face centroid, a node placed by a template whose
-    // footprint is not a parameter rectangle) can leave a warped patch by up to its warp.
-    s.tolerances.push_back(mesh_check_surface_tolerance * quad_diameter(s.quads.back()) +
-                           quad_warp(s.quads.back()));
-  }
+  const int64_t faces = static_cast<int64_t>(s.slots.size());
+  s.nodes.resize(s.slots.size());
+  s.quads.resize(s.slots.size());
+  s.tolerances.resize(s.slots.size());
+  parallel_chunks(threads, faces, 1 << 12, [&](int64_t, int64_t begin, int64_t end) {
+    for (int64_t i = begin; i < end; ++i) {
+      const HexCell& c = mesh.hexes[s.slots[i].hex];
+      const int* fv = hex_faces[s.slots[i].local_face];
+      const std::array<int32_t, 4> n = {c[fv[0]], c[fv[1]], c[fv[2]], c[fv[3]]};
+      s.nodes[i] = n;
+      s.quads[i] = {mesh.points[n[0]], mesh.points[n[1]], mesh.points[n[2]], mesh.points[n[3]]};
+      // A point averaged from patch points (a sub-face centroid, a node placed by a template
+      // whose footprint is not a parameter rectangle) can leave a warped patch by up to its warp.
+      s.tolerances[i] =
+          mesh_check_surface_tolerance * quad_diameter(s.quads[i]) + quad_warp(s.quads[i]);
+    }
+  });
   return s;
 }
 
@@ -402,21 +407,41 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   if (r.hexes > 0) r.mean_scaled_jacobian = sum_scaled_jacobian / static_cast<double>(r.hexes);
 
   // Boundary surface: closedness and area.
-  const BoundarySurface surface = boundary_surface(mesh, std::move(adjacency.boundary_faces));
+  const BoundarySurface surface =
+      boundary_surface(mesh, std::move(adjacency.boundary_faces), threads);
   r.boundary_faces = static_cast<int64_t>(surface.slots.size());
   // Every boundary edge must be used by exactly two boundary faces: count the uses of each
   // (lower node, higher node) pair over the boundary faces (sorted, linear in the boundary).
-  std::vector<uint64_t> boundary_edges;
-  boundary_edges.reserve(4 * surface.slots.size());
-  for (size_t i = 0; i < surface.slots.size(); ++i) {
-    const auto& n = surface.nodes[i];
-    for (int k = 0; k < 4; ++k) {
-      const uint32_t a = static_cast<uint32_t>(n[k]), b = static_cast<uint32_t>(n[(k + 1) % 4]);
-      boundary_edges.push_back(static_cast<uint64_t>(std::min(a, b)) << 32 | std::max(a, b));
-    }
-    r.boundary_area += quad_area(surface.quads[i]);
+  // Keys and areas per face on every thread; the areas summed in face order, so the total does
+  // not depend on the thread count.
+  std::vector<uint64_t> boundary_edges(4 * surface.slots.size());
+  {
+    std::vector<double> areas(surface.slots.size());
+    parallel_chunks(threads, r.boundary_faces, 1 << 12, [&](int64_t, int64_t begin, int64_t end) {
+      for (int64_t i = begin; i < end; ++i) {
+        const auto& n = surface.nodes[i];
+        for (int k = 0; k < 4; ++k) {
+          const uint32_t a = static_cast<uint32_t>(n[k]), b = static_cast<uint32_t>(n[(k + 1) % 4]);
+          boundary_edges[4 * i + k] = static_cast<uint64_t>(std::min(a, b)) << 32 | std::max(a, b);
+        }
+        areas[i] = quad_area(surface.quads[i]);
+      }
+    });
+    for (double area : areas) r.boundary_area += area;
   }
-  std::sort(boundary_edges.begin(), boundary_edges.end());
+  // Sorted in two halves on two threads, then merged.
+  if (threads > 1 && boundary_edges.size() > (size_t{1} << 16)) {
+    const auto middle =
+        boundary_edges.begin() + static_cast<std::ptrdiff_t>(boundary_edges.size() / 2);
+    parallel_chunks(2, 2, 1, [&](int64_t half, int64_t, int64_t) {
+      if (half == 0)
+        std::sort(boundary_edges.begin(), middle);
+      else
+        std::sort(middle, boundary_edges.end());
+    });
+    std::inplace_merge(boundary_edges.begin(), middle, boundary_edges.end());
+  } else
+    std::sort(boundary_edges.begin(), boundary_edges.end());
   for (size_t i = 0; i < boundary_edges.size();) {
     size_t j = i;
     while (j < boundary_edges.size() && boundary_edges[j] == boundary_edges[i]) ++j;
@@ -429,7 +454,7 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   std::vector<int32_t> non_conformal;  // indices into surface
   if (reference) {
     const BoundarySurface reference_surface = boundary_surface(
-        *reference, hex_face_adjacency_build(*reference, threads, false).boundary_faces);
+        *reference, hex_face_adjacency_build(*reference, threads, false).boundary_faces, threads);
     const QuadGrid grid(reference_surface.quads, reference_surface.tolerances);
     non_conformal = boundary_faces_where(threads, surface, [&](int32_t i) {
       const Quad& q = surface.quads[i];

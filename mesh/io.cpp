@@ -254,8 +254,10 @@ HexMesh mesh_read_format(const std::string& path, MeshFormat format) {
   switch (format) {
     case MeshFormat::medit:
       return io_detail::medit_read(path, io_detail::FileBytes(path).view());
-    case MeshFormat::vtk_legacy:
-      return io_detail::vtk_read(path, io_detail::FileBytes(path).view());
+    case MeshFormat::vtk_legacy: {
+      const io_detail::FileBytes file(path);
+      return io_detail::vtk_read(path, file.view(), &file);
+    }
     case MeshFormat::vtu: {
       const io_detail::FileBytes file(path);
       return io_detail::vtu_read(path, file.view(), &file);

@@ -4,6 +4,7 @@
 /// (12) is hexrefine's order; VTK_VOXEL (11) is read with its nodes 2/3 and 6/7 swapped.
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "mesh/atomic_file.hpp"
@@ -177,7 +178,7 @@ void vtk_read_data_block(TextCursor& in, bool binary, VtkReadState& st, bool cel
 
 }  // namespace
 
-HexMesh vtk_read(const std::string& path, std::string_view text) {
+HexMesh vtk_read(const std::string& path, std::string_view text, const FileBytes* file) {
   TextCursor in(path, text);
   const std::string_view first = in.rest_of_line();
   if (first.substr(0, 14) != "# vtk DataFile")
@@ -194,8 +195,31 @@ HexMesh vtk_read(const std::string& path, std::string_view text) {
             "'");
 
   VtkReadState st;
-  std::vector<int64_t> offsets, connectivity, types;
+  // Cells as they are read: the node count of each, and the nodes of those with eight (the only
+  // ones CELL_TYPES can make hexes), in file order. No 64-bit copy of the lists: for 11.4 M hexes
+  // those were 1.7 GB beside the 0.4 GB the hexes need.
+  std::vector<int32_t> nodes_of_cell;
+  std::vector<HexCell> eight;
   bool have_points = false, have_cells = false, have_types = false;
+  // The file's pages already read leave the resident memory section by section.
+  size_t released = 0;
+  auto release_read = [&] {
+    if (file == nullptr || in.position() <= released) return;
+    file->release(text.substr(released, in.position() - released));
+    released = in.position();
+  };
+  // Node v of cell c, kept as a 32-bit id: refused here when no point can have it (the range
+  // against the points is checked where the cell becomes a hex).
+  auto cell_node = [&](int64_t c, int64_t v) {
+    if (v < 0 || v > INT32_MAX)
+      in.fail("cell " + std::to_string(c) + " refers to point " + std::to_string(v) +
+              (have_points ? ", expected 0.." + std::to_string(st.mesh.points.size() - 1) : ""));
+    return static_cast<int32_t>(v);
+  };
+  auto add_cell = [&](int64_t nodes) {
+    if (nodes_of_cell.size() >= INT32_MAX) in.fail("too many cells");
+    nodes_of_cell.push_back(static_cast<int32_t>(nodes));
+  };
   while (!in.at_end()) {
     const std::string_view key = in.token("a section keyword");
     if (key == "POINTS") {
@@ -203,98 +227,154 @@ HexMesh vtk_read(const std::string& path, std::string_view text) {
       const std::string_view type = in.token("point data type");
       in.check_count(n, "point count", 3 * (binary ? std::max(1, vtk_type_size(type)) : 2));
       st.mesh.points.resize(static_cast<size_t>(n));
-      int64_t i = 0;
-      vtk_read_values(in, binary, type, 3 * n, "point coordinate", false, [&](double d, int64_t v) {
-        st.mesh.points[i / 3][i % 3] = vtk_type_is_integer(type) ? static_cast<double>(v) : d;
-        ++i;
-      });
+      if (binary && type == "double") {  // the common case, read in one pass over the bytes
+        in.rest_of_line();
+        const char* p = in.raw(static_cast<size_t>(3 * n) * 8, "point coordinate");
+        for (int64_t i = 0; i < 3 * n; ++i, p += 8) {
+          const double d = read_big_endian<double>(p);
+          if (!std::isfinite(d))
+            in.fail("point coordinate " + std::to_string(i) + " is NaN or infinite");
+          st.mesh.points[i / 3][i % 3] = d;
+        }
+      } else {
+        int64_t i = 0;
+        vtk_read_values(
+            in, binary, type, 3 * n, "point coordinate", false, [&](double d, int64_t v) {
+              st.mesh.points[i / 3][i % 3] = vtk_type_is_integer(type) ? static_cast<double>(v) : d;
+              ++i;
+            });
+      }
       have_points = true;
     } else if (key == "CELLS") {
+      if (have_cells) in.fail("a second CELLS section");
       const int64_t a = in.integer("cell count");
       const int64_t b = in.integer("cell list size");
       if (in.peek() == "OFFSETS") {  // VTK 5.x layout: a offsets, b connectivity entries
         in.token("OFFSETS");
         const std::string_view ot = in.token("offset data type");
         in.check_count(a, "offset count", binary ? 4 : 2);
+        std::vector<int64_t> offsets;
         offsets.reserve(static_cast<size_t>(a));
         vtk_read_values(in, binary, ot, a, "cell offset", false,
                         [&](double, int64_t v) { offsets.push_back(v); });
+        if (offsets.empty() || offsets[0] != 0) in.fail("cell offsets must start with 0");
         in.expect("CONNECTIVITY");
         const std::string_view ct = in.token("connectivity data type");
         in.check_count(b, "connectivity size", binary ? 4 : 2);
-        connectivity.reserve(static_cast<size_t>(b));
-        vtk_read_values(in, binary, ct, b, "cell connectivity", false,
-                        [&](double, int64_t v) { connectivity.push_back(v); });
-        if (offsets.empty() || offsets[0] != 0) in.fail("cell offsets must start with 0");
+        for (size_t c = 1; c < offsets.size(); ++c)
+          if (offsets[c] < offsets[c - 1] || offsets[c] > b)
+            in.fail("cell offsets not increasing or beyond the connectivity at cell " +
+                    std::to_string(c - 1));
+        // Cell c holds entries offsets[c] .. offsets[c + 1] (the last: up to b).
+        const int64_t cells = static_cast<int64_t>(offsets.size()) - 1;
+        for (int64_t c = 0; c < cells; ++c) add_cell(offsets[c + 1] - offsets[c]);
+        eight.reserve(
+            static_cast<size_t>(std::count(nodes_of_cell.begin(), nodes_of_cell.end(), 8)));
+        int64_t c = 0, at = 0;
+        HexCell h{};
+        vtk_read_values(in, binary, ct, b, "cell connectivity", false, [&](double, int64_t v) {
+          while (c < cells && at >= offsets[c + 1]) ++c;
+          if (c < cells && nodes_of_cell[c] == 8) {
+            h[at - offsets[c]] = cell_node(c, v);
+            if (at - offsets[c] == 7) eight.push_back(h);
+          }
+          ++at;
+        });
       } else {  // classic layout: a cells, b = sum of (1 + nodes) integers
         in.check_count(a, "cell count", binary ? 8 : 4);
         in.check_count(b, "cell list size", binary ? 4 : 2, INT32_MAX);
-        std::vector<int64_t> list;
-        list.reserve(static_cast<size_t>(b));
-        vtk_read_values(in, binary, "int", b, "cell list", false,
-                        [&](double, int64_t v) { list.push_back(v); });
-        offsets.reserve(static_cast<size_t>(a) + 1);
-        offsets.push_back(0);
-        size_t p = 0;
-        for (int64_t c = 0; c < a; ++c) {
-          if (p >= list.size())
-            in.fail("CELLS list ends at cell " + std::to_string(c) + " of " + std::to_string(a));
-          const int64_t k = list[p++];
-          if (k < 0 || k > static_cast<int64_t>(list.size() - p))
-            in.fail("cell " + std::to_string(c) + " claims " + std::to_string(k) +
+        nodes_of_cell.reserve(static_cast<size_t>(a));
+        eight.reserve(static_cast<size_t>(std::min(a, b / 9)));  // a hex takes 9 entries
+        // Walks the list: a node count, then that many node ids, cell after cell.
+        int64_t c = 0, at = 0, left = -1;
+        HexCell h{};
+        auto cell_count = [&](int64_t v) {
+          if (c == a) in.fail("CELLS list size " + std::to_string(b) + " does not match its cells");
+          if (v < 0 || v > b - at - 1)
+            in.fail("cell " + std::to_string(c) + " claims " + std::to_string(v) +
                     " nodes, more than the CELLS list holds");
-          connectivity.insert(connectivity.end(), list.begin() + p, list.begin() + p + k);
-          p += k;
-          offsets.push_back(static_cast<int64_t>(connectivity.size()));
+          add_cell(v);
+        };
+        if (binary) {  // big-endian int32s read where they lie, a cell at a time
+          in.rest_of_line();
+          const char* p = in.raw(static_cast<size_t>(b) * 4, "cell list");
+          while (at < b) {
+            const int64_t k = read_big_endian<int32_t>(p + 4 * at);
+            cell_count(k);
+            if (k == 8) {
+              for (int j = 0; j < 8; ++j)
+                h[j] = cell_node(c, read_big_endian<int32_t>(p + 4 * (at + 1 + j)));
+              eight.push_back(h);
+            }
+            at += 1 + k;
+            ++c;
+          }
+        } else {
+          vtk_read_values(in, binary, "int", b, "cell list", false, [&](double, int64_t v) {
+            if (left < 0) {  // a cell's node count
+              cell_count(v);
+              left = v;
+            } else {
+              if (nodes_of_cell[c] == 8) h[8 - left] = cell_node(c, v);
+              --left;
+            }
+            if (left == 0) {
+              if (nodes_of_cell[c] == 8) eight.push_back(h);
+              ++c;
+              left = -1;
+            }
+            ++at;
+          });
         }
-        if (p != list.size())
-          in.fail("CELLS list size " + std::to_string(b) + " does not match its cells");
+        if (c < a)
+          in.fail("CELLS list ends at cell " + std::to_string(c) + " of " + std::to_string(a));
       }
-      for (size_t c = 1; c < offsets.size(); ++c)
-        if (offsets[c] < offsets[c - 1] || offsets[c] > static_cast<int64_t>(connectivity.size()))
-          in.fail("cell offsets not increasing or beyond the connectivity at cell " +
-                  std::to_string(c - 1));
       have_cells = true;
+      release_read();
     } else if (key == "CELL_TYPES") {
       const int64_t n = in.integer("cell type count");
       in.check_count(n, "cell type count", binary ? 4 : 2);
-      types.reserve(static_cast<size_t>(n));
-      vtk_read_values(in, binary, "int", n, "cell type", false,
-                      [&](double, int64_t v) { types.push_back(v); });
       if (!have_cells) in.fail("CELL_TYPES before CELLS");
-      if (static_cast<int64_t>(offsets.size()) != n + 1)
+      if (have_types) in.fail("a second CELL_TYPES section");
+      if (static_cast<int64_t>(nodes_of_cell.size()) != n)
         in.fail("CELL_TYPES count " + std::to_string(n) + " differs from the CELLS count " +
-                std::to_string(offsets.size() - 1));
-      // Build the hexes now so that cell data can be mapped to them.
+                std::to_string(nodes_of_cell.size()));
+      // The hexes are built now so that cell data can be mapped to them: the eight-node cells
+      // that are hexes, moved down within the same array.
       st.hex_of_cell.assign(static_cast<size_t>(n), -1);
       const int64_t np = static_cast<int64_t>(st.mesh.points.size());
-      for (int64_t c = 0; c < n; ++c) {
-        const int kind = vtk_cell_kind(types[c]);
-        const int64_t nodes = offsets[c + 1] - offsets[c];
-        if (kind == 0) continue;
+      int64_t c = 0;
+      size_t next_eight = 0, hexes = 0;
+      vtk_read_values(in, binary, "int", n, "cell type", false, [&](double, int64_t type) {
+        const int kind = vtk_cell_kind(type);
+        const int32_t nodes = nodes_of_cell[c];
+        const size_t slot = next_eight;
+        if (nodes == 8) ++next_eight;
         if (kind == -1)
-          in.fail("cell " + std::to_string(c) + " has VTK type " + std::to_string(types[c]) +
+          in.fail("cell " + std::to_string(c) + " has VTK type " + std::to_string(type) +
                   ", a volume cell that is not a linear hexahedron (only hexes are supported)");
         if (kind == -2)
-          in.fail("cell " + std::to_string(c) + " has unknown VTK type " +
-                  std::to_string(types[c]));
-        if (nodes != 8)
-          in.fail("hexahedron " + std::to_string(c) + " has " + std::to_string(nodes) +
-                  " nodes, expected 8");
-        HexCell h;
-        for (int k = 0; k < 8; ++k) {
-          const int64_t v = connectivity[offsets[c] + k];
-          if (v < 0 || v >= np)
-            in.fail("cell " + std::to_string(c) + " refers to point " + std::to_string(v) +
-                    ", expected 0.." + std::to_string(np - 1));
-          h[k] = static_cast<int32_t>(v);
+          in.fail("cell " + std::to_string(c) + " has unknown VTK type " + std::to_string(type));
+        if (kind != 0) {
+          if (nodes != 8)
+            in.fail("hexahedron " + std::to_string(c) + " has " + std::to_string(nodes) +
+                    " nodes, expected 8");
+          HexCell h = eight[slot];
+          for (int k = 0; k < 8; ++k)
+            if (h[k] >= np)
+              in.fail("cell " + std::to_string(c) + " refers to point " + std::to_string(h[k]) +
+                      ", expected 0.." + std::to_string(np - 1));
+          if (type == 11) std::swap(h[2], h[3]), std::swap(h[6], h[7]);
+          st.hex_of_cell[c] = static_cast<int32_t>(hexes);
+          eight[hexes++] = h;
         }
-        if (types[c] == 11) std::swap(h[2], h[3]), std::swap(h[6], h[7]);
-        if (st.mesh.hexes.size() >= INT32_MAX) in.fail("too many hexes");
-        st.hex_of_cell[c] = static_cast<int32_t>(st.mesh.hexes.size());
-        st.mesh.hexes.push_back(h);
-      }
+        ++c;
+      });
+      eight.resize(hexes);
+      st.mesh.hexes = std::move(eight);
+      std::vector<int32_t>().swap(nodes_of_cell);
       have_types = true;
+      release_read();
     } else if (key == "CELL_DATA" || key == "POINT_DATA") {
       const int64_t n = in.integer("data count");
       if (key == "CELL_DATA" && (!have_types || n != static_cast<int64_t>(st.hex_of_cell.size())))

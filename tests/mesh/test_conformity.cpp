@@ -369,6 +369,27 @@ TEST(Conformity, DuplicateNodesOnAnyThreadCount) {
   EXPECT_EQ(mesh_check(m, nullptr, 2).duplicate_nodes, 200);
 }
 
+TEST(Conformity, WholeReportIsTheSameOnAnyThreadCount) {
+  // A 100 x 100 x 1 slab (20,400 boundary faces: its boundary edges are sorted in two halves on
+  // two threads) with hexes (10, 11) and (11, 10) removed: hexes (10, 10) and (11, 11) then
+  // touch along one edge only, which four boundary faces share, and the hole's eight walls are
+  // off the slab's own surface.
+  const HexMesh reference = fixture_brick(100, 100, 1);
+  HexMesh m = reference;
+  m.hexes.erase(m.hexes.begin() + fixture_brick_hex(100, 100, 10, 11, 0));  // the higher id first
+  m.hexes.erase(m.hexes.begin() + fixture_brick_hex(100, 100, 11, 10, 0));
+  const MeshCheckReport one = mesh_check(m, &reference, 1);
+  EXPECT_EQ(one.hexes, 9998);
+  EXPECT_EQ(one.boundary_faces, 20404);
+  EXPECT_EQ(one.nonmanifold_boundary_edges, 1);
+  EXPECT_EQ(one.non_conformal_faces, 8);
+  EXPECT_NEAR(one.volume, 9998.0, 1e-9);
+  for (int threads : {2, 3}) {
+    const nlohmann::json a = one, b = mesh_check(m, &reference, threads);
+    EXPECT_EQ(a.dump(), b.dump()) << threads << " threads";
+  }
+}
+
 TEST(Conformity, EmptyMesh) {
   const MeshCheckReport r = mesh_check(HexMesh{});
   EXPECT_EQ(r.hexes, 0);

@@ -95,6 +95,15 @@ void vtk_read_array(TextCursor& in, bool binary, VtkReadState& st, bool cell_dat
   }
   in.check_count(count, what + " value count", binary ? vtk_type_size(type) : 2, INT64_MAX / 16);
   std::vector<int32_t> values(st.mesh.hexes.size());
+  if (binary && (type == "int" || type == "vtktypeint32")) {  // the common case, in one pass
+    in.rest_of_line();
+    const char* p = in.raw(static_cast<size_t>(count) * 4, what);
+    for (int64_t i = 0; i < count; ++i)
+      if (const int32_t h = st.hex_of_cell[i]; h >= 0)
+        values[h] = read_big_endian<int32_t>(p + 4 * i);
+    st.mesh.attributes.push_back({name, std::move(values)});
+    return;
+  }
   int64_t i = 0;
   vtk_read_values(in, binary, type, count, what, false, [&](double, int64_t v) {
     const int32_t h = st.hex_of_cell[i++];
@@ -230,12 +239,13 @@ HexMesh vtk_read(const std::string& path, std::string_view text, const FileBytes
       if (binary && type == "double") {  // the common case, read in one pass over the bytes
         in.rest_of_line();
         const char* p = in.raw(static_cast<size_t>(3 * n) * 8, "point coordinate");
-        for (int64_t i = 0; i < 3 * n; ++i, p += 8) {
-          const double d = read_big_endian<double>(p);
-          if (!std::isfinite(d))
-            in.fail("point coordinate " + std::to_string(i) + " is NaN or infinite");
-          st.mesh.points[i / 3][i % 3] = d;
-        }
+        for (int64_t i = 0; i < n; ++i)
+          for (int d = 0; d < 3; ++d, p += 8) {
+            const double x = read_big_endian<double>(p);
+            if (!std::isfinite(x))
+              in.fail("point coordinate " + std::to_string(3 * i + d) + " is NaN or infinite");
+            st.mesh.points[i][d] = x;
+          }
       } else {
         int64_t i = 0;
         vtk_read_values(
@@ -383,6 +393,7 @@ HexMesh vtk_read(const std::string& path, std::string_view text, const FileBytes
       if (key == "POINT_DATA" && n != static_cast<int64_t>(st.mesh.points.size()))
         in.fail("POINT_DATA count " + std::to_string(n) + " does not match the point count");
       vtk_read_data_block(in, binary, st, key == "CELL_DATA", n);
+      release_read();
     } else if (key == "FIELD") {  // dataset-level field data (e.g. TIME): skipped
       vtk_read_field(in, binary, st, -1);
     } else if (key == "METADATA") {

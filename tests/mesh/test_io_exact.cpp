@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <thread>
 
@@ -197,6 +199,22 @@ TEST(IoTextWriter, ReadBigEndianInvertsTheWriter) {
   EXPECT_EQ(io_detail::read_big_endian<double>(b.data()), d);
   EXPECT_EQ(io_detail::read_big_endian<int16_t>(b.data() + 8), s);
   EXPECT_EQ(io_detail::read_big_endian<uint64_t>(b.data() + 10), u);
+}
+
+TEST(IoTextCursor, CountsTheNewlinesOfBinaryBlocksOfAnyLength) {
+  // The byte-lane count against a plain one, across its 4,080-byte blocks and their tails, on
+  // data that is all newlines (each lane at its 255 limit) and on random bytes.
+  std::mt19937 random(7);
+  std::string bytes(20000, '\n');
+  for (int fill = 0; fill < 2; ++fill) {
+    if (fill == 1)
+      for (char& c : bytes) c = static_cast<char>(random());
+    for (size_t n : {0, 1, 15, 16, 17, 4079, 4080, 4081, 8160, 12345, 20000}) {
+      const size_t plain = static_cast<size_t>(std::count(bytes.begin(), bytes.begin() + n, '\n'));
+      EXPECT_EQ(io_detail::bytes_count_newlines(bytes.data(), n), plain) << fill << " " << n;
+    }
+  }
+  EXPECT_EQ(io_detail::bytes_count_newlines(std::string(20000, '\n').data(), 20000), 20000u);
 }
 
 TEST(IoReadAll, ReadsEmptyAndMultiPieceFilesWhole) {

@@ -278,7 +278,9 @@ def command_section():
           f"threads): {'; '.join(cells)}. The refine stage, whose code is the same in both runs, took "
           f"{spread} times as long in this run as in that one (.e, .vtu, .msh): the machine's speed "
           "differs between runs and even between the commands of one run, so compare stages whose "
-          "refine stage took about as long (here the .vtu rows), not the bare totals.")
+          "refine stage took about as long, not the bare totals"
+          + (" (that run was one run per command, not a median)." if p.get("repeats", 1) == 1
+             else "."))
         w("")
     small_pages_path = os.path.join(here, "command_no_huge_pages.json")
     if os.path.exists(small_pages_path):

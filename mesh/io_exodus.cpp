@@ -7,7 +7,9 @@
 /// the reader takes block_id from such a name, else from the Exodus id. Coordinates are written as
 /// doubles (exact round trip). Hexes are written block by block with the element id map holding
 /// each hex's index + 1; the reader orders hexes by id when the ids of the hexes are a permutation
-/// of 1..n, so a written mesh reads back in its own order.
+/// of 1..n, so a written mesh reads back in its own order. The library writes the definitions and
+/// the small variables; the bulk arrays (coordinates, connectivity, id map, element variables)
+/// are written afterwards at the offsets of the classic netCDF header it wrote.
 
 #include <exodusII.h>
 #include <netcdf.h>
@@ -473,10 +475,10 @@ void exodus_write(const std::string& path, const HexMesh& mesh,
   {
     int comp_ws = 8, io_ws = 8;
     ExodusFile file;
-    // Classic netCDF storage (3.5 s for the 960 MB of an 11.4 M-hex mesh once the header space
-    // below stops the data moves; it was 6 to 7.5 s, netCDF-4 3 s): a truncated or corrupted
-    // HDF5 file can crash the HDF5 library inside the reader, where the classic header is
-    // checked before the library sees it (netcdf_classic_header_check).
+    // Classic netCDF storage: a header and contiguous arrays, so the bulk data can go straight
+    // into place (ExodusBulkWriter, below); and a truncated or corrupted HDF5 file can crash the
+    // HDF5 library inside the reader, where the classic header is checked before the library
+    // sees it (netcdf_classic_header_check).
     file.id = ex_create(tmp.c_str(), EX_CLOBBER | EX_ALL_INT64_API, &comp_ws, &io_ws);
     if (file.id < 0) failed("cannot create (folder missing or not writable)");
     // Every value below is written, so netCDF's pre-fill of each variable would write the file

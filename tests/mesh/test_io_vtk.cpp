@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cstdint>
 #include <fstream>
 #include <iterator>
 
@@ -66,6 +68,53 @@ TEST(IoVtk, ReadsNewLayoutSkipsQuadsAndReordersVoxels) {
   EXPECT_EQ(r.hexes[1], (HexCell{1, 2, 5, 4, 7, 8, 11, 10}));
   ASSERT_NE(mesh_find_attribute(r, attribute_block_id), nullptr);
   EXPECT_EQ(*mesh_find_attribute(r, attribute_block_id), (std::vector<int32_t>{5, 7}));
+}
+
+TEST(IoVtk, ReadsBinaryClassicLayoutSkipsQuadsAndReordersVoxels) {
+  // The same three cells as above in the classic layout, BINARY (big-endian): the reader walks
+  // the cell list where it lies in the file, keeping only the eight-node cells' ids.
+  const auto dir = test_temp_dir("io_vtk_binary_layout");
+  const auto p = dir / "mixed.vtk";
+  auto be32 = [](int32_t v) {
+    std::string b(4, '\0');
+    for (int k = 0; k < 4; ++k) b[k] = static_cast<char>(static_cast<uint32_t>(v) >> (24 - 8 * k));
+    return b;
+  };
+  auto be64 = [](double d) {
+    const uint64_t u = std::bit_cast<uint64_t>(d);
+    std::string b(8, '\0');
+    for (int k = 0; k < 8; ++k) b[k] = static_cast<char>(u >> (56 - 8 * k));
+    return b;
+  };
+  std::string text =
+      "# vtk DataFile Version 3.0\nt\nBINARY\nDATASET UNSTRUCTURED_GRID\n"
+      "POINTS 12 double\n";
+  for (int i = 0; i < 12; ++i) text += be64(i % 3) + be64((i / 3) % 2) + be64(i / 6);
+  text += "\nCELLS 3 23\n";
+  for (int32_t v : {8, 0, 1, 4, 3, 6, 7, 10, 9, 4, 0, 1, 4, 3, 8, 1, 2, 4, 5, 7, 8, 10, 11})
+    text += be32(v);
+  text += "\nCELL_TYPES 3\n" + be32(12) + be32(9) + be32(11);
+  text += "\nCELL_DATA 3\nSCALARS block_id int 1\nLOOKUP_TABLE default\n" + be32(5) + be32(6) +
+          be32(7) + "\n";
+  io_write_text(p, text);
+  const HexMesh r = mesh_read(p.string());
+  ASSERT_EQ(r.hex_count(), 2);
+  ASSERT_EQ(r.point_count(), 12);
+  EXPECT_EQ(r.points[11], Eigen::Vector3d(2, 1, 1));
+  EXPECT_EQ(r.hexes[0], (HexCell{0, 1, 4, 3, 6, 7, 10, 9}));
+  EXPECT_EQ(r.hexes[1], (HexCell{1, 2, 5, 4, 7, 8, 11, 10}));
+  ASSERT_NE(mesh_find_attribute(r, attribute_block_id), nullptr);
+  EXPECT_EQ(*mesh_find_attribute(r, attribute_block_id), (std::vector<int32_t>{5, 7}));
+  // A node count past the end of the list is refused, naming the cell.
+  std::string bad = text;
+  bad.replace(bad.find("CELLS 3 23\n") + 11, 4, be32(30));
+  io_write_text(dir / "bad.vtk", bad);
+  try {
+    mesh_read((dir / "bad.vtk").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cell 0 claims 30 nodes"), std::string::npos) << e.what();
+  }
 }
 
 TEST(IoVtk, RefusesTetraAndBadPointIds) {

@@ -237,8 +237,9 @@ double mesh_volume(const HexMesh& mesh) {
 /// bucketed by a coarse cell (about four points per cell, one counting sort); near pairs share a
 /// cell unless they straddle a cell wall, so only points within the tolerance of a wall also
 /// search the neighbouring cells. The cell size is an irrational multiple of the mean spacing so
-/// structured grids do not put their points on the walls. Worst case (many points in one cell)
-/// is quadratic in that cell.
+/// structured grids do not put their points on the walls. A crowded cell (a refined region is
+/// far denser than the box's mean) is sorted by x and swept, comparing only pairs within the
+/// tolerance in x: k log k for k points, quadratic only if they share an x within the tolerance.
 int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
@@ -309,10 +310,28 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
     if (i != j && (mesh.points[i] - mesh.points[j]).norm() <= tolerance)
       std::atomic_ref<char>(duplicate[std::max(i, j)]).store(1, std::memory_order_relaxed);
   };
+  // A crowded cell (a refined region is far denser than the bounding box's mean) is sorted by x
+  // and swept: only pairs within the tolerance in x are compared, so it costs k log k, not k^2.
   parallel_chunks(threads, cells, chunk_points, [&](int64_t, int64_t begin, int64_t end) {
-    for (int64_t c = begin; c < end; ++c)
-      for (uint32_t a = cell_begin(c); a < cell_end[c]; ++a)
-        for (uint32_t b = a + 1; b < cell_end[c]; ++b) compare(sorted[a], sorted[b]);
+    for (int64_t c = begin; c < end; ++c) {
+      int32_t* first = sorted.get() + cell_begin(c);
+      int32_t* last = sorted.get() + cell_end[c];
+      if (last - first <= 16) {
+        for (int32_t* a = first; a < last; ++a)
+          for (int32_t* b = a + 1; b < last; ++b) compare(*a, *b);
+        continue;
+      }
+      // NaN sorts last (as +infinity), so the order is strict and no NaN pair is swept.
+      auto key = [&](int32_t i) {
+        const double x = mesh.points[i].x();
+        return std::isnan(x) ? std::numeric_limits<double>::infinity() : x;
+      };
+      std::sort(first, last, [&](int32_t i, int32_t j) {
+        return key(i) < key(j) || (key(i) == key(j) && i < j);
+      });
+      for (int32_t* a = first; a < last; ++a)
+        for (int32_t* b = a + 1; b < last && key(*b) - key(*a) <= tolerance; ++b) compare(*a, *b);
+    }
   });
   parallel_chunks(threads, static_cast<int64_t>(near_wall.size()), 1,
                   [&](int64_t chunk, int64_t, int64_t) {

@@ -390,6 +390,29 @@ TEST(Conformity, WholeReportIsTheSameOnAnyThreadCount) {
   }
 }
 
+TEST(Conformity, DuplicateNodesInACrowdedCell) {
+  // 3,000 extra points packed into a ball 1e-4 wide inside a 10^3 brick (a refined region is far
+  // denser than the box's mean, so one search cell holds them all and is swept in x), among them
+  // 100 copies at 0.5 x the tolerance of a point of the ball (duplicates), 100 at 2 x it (not),
+  // and 50 copies that differ only in y (same x: the sweep must still compare them).
+  HexMesh m = fixture_brick(10, 10, 10);
+  const double tolerance = mesh_check_duplicate_tolerance * std::sqrt(3.0 * 10 * 10);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> u(-5e-5, 5e-5);
+  const int32_t ball = m.point_count();
+  for (int i = 0; i < 3000; ++i)
+    m.points.push_back(Eigen::Vector3d(5.3 + u(random), 4.7 + u(random), 5.1 + u(random)));
+  for (int i = 0; i < 100; ++i) {
+    m.points.push_back(m.points[ball + i] + 0.5 * tolerance * Eigen::Vector3d(1, 2, 2) / 3.0);
+    m.points.push_back(m.points[ball + 1000 + i] +
+                       2.0 * tolerance * Eigen::Vector3d(1, 2, 2) / 3.0);
+  }
+  for (int i = 0; i < 50; ++i)
+    m.points.push_back(m.points[ball + 2000 + i] + Eigen::Vector3d(0, 0.5 * tolerance, 0));
+  EXPECT_EQ(mesh_check(m, nullptr, 1).duplicate_nodes, 150);
+  EXPECT_EQ(mesh_check(m, nullptr, 2).duplicate_nodes, 150);
+}
+
 TEST(Conformity, EmptyMesh) {
   const MeshCheckReport r = mesh_check(HexMesh{});
   EXPECT_EQ(r.hexes, 0);

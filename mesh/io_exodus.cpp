@@ -18,7 +18,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -398,13 +397,13 @@ class ExodusBulkWriter {
       for (size_t k = begin; k < end; ++k, out += width) {
         const auto value = value_of(k);
         if (v.type == NC_DOUBLE)
-          store_big_endian(std::bit_cast<uint64_t>(static_cast<double>(value)), out, 8);
+          store(value_big_endian(static_cast<double>(value)), out);
         else if (v.type == NC_FLOAT)
-          store_big_endian(std::bit_cast<uint32_t>(static_cast<float>(value)), out, 4);
+          store(value_big_endian(static_cast<float>(value)), out);
         else if (v.type == NC_INT64)
-          store_big_endian(static_cast<uint64_t>(static_cast<int64_t>(value)), out, 8);
+          store(value_big_endian(static_cast<int64_t>(value)), out);
         else
-          store_big_endian(static_cast<uint32_t>(static_cast<int32_t>(value)), out, 4);
+          store(value_big_endian(static_cast<int32_t>(value)), out);
       }
       write_at(v.begin + (first + begin) * width);
     }
@@ -417,9 +416,9 @@ class ExodusBulkWriter {
   }
 
  private:
-  static void store_big_endian(uint64_t bits, unsigned char* out, size_t width) {
-    for (size_t i = 0; i < width; ++i)
-      out[i] = static_cast<unsigned char>(bits >> (8 * (width - 1 - i)));
+  template <class T>
+  static void store(T v, unsigned char* out) {
+    std::memcpy(out, &v, sizeof v);
   }
   void write_at(uint64_t offset) {
     const unsigned char* data = buffer_.data();

@@ -95,15 +95,6 @@ void vtk_read_array(TextCursor& in, bool binary, VtkReadState& st, bool cell_dat
   }
   in.check_count(count, what + " value count", binary ? vtk_type_size(type) : 2, INT64_MAX / 16);
   std::vector<int32_t> values(st.mesh.hexes.size());
-  if (binary && (type == "int" || type == "vtktypeint32")) {  // the common case, in one pass
-    in.rest_of_line();
-    const char* p = in.raw(static_cast<size_t>(count) * 4, what);
-    for (int64_t i = 0; i < count; ++i)
-      if (const int32_t h = st.hex_of_cell[i]; h >= 0)
-        values[h] = read_big_endian<int32_t>(p + 4 * i);
-    st.mesh.attributes.push_back({name, std::move(values)});
-    return;
-  }
   int64_t i = 0;
   vtk_read_values(in, binary, type, count, what, false, [&](double, int64_t v) {
     const int32_t h = st.hex_of_cell[i++];
@@ -236,24 +227,11 @@ HexMesh vtk_read(const std::string& path, std::string_view text, const FileBytes
       const std::string_view type = in.token("point data type");
       in.check_count(n, "point count", 3 * (binary ? std::max(1, vtk_type_size(type)) : 2));
       st.mesh.points.resize(static_cast<size_t>(n));
-      if (binary && type == "double") {  // the common case, read in one pass over the bytes
-        in.rest_of_line();
-        const char* p = in.raw(static_cast<size_t>(3 * n) * 8, "point coordinate");
-        for (int64_t i = 0; i < n; ++i)
-          for (int d = 0; d < 3; ++d, p += 8) {
-            const double x = read_big_endian<double>(p);
-            if (!std::isfinite(x))
-              in.fail("point coordinate " + std::to_string(3 * i + d) + " is NaN or infinite");
-            st.mesh.points[i][d] = x;
-          }
-      } else {
-        int64_t i = 0;
-        vtk_read_values(
-            in, binary, type, 3 * n, "point coordinate", false, [&](double d, int64_t v) {
-              st.mesh.points[i / 3][i % 3] = vtk_type_is_integer(type) ? static_cast<double>(v) : d;
-              ++i;
-            });
-      }
+      int64_t i = 0;
+      vtk_read_values(in, binary, type, 3 * n, "point coordinate", false, [&](double d, int64_t v) {
+        st.mesh.points[i / 3][i % 3] = vtk_type_is_integer(type) ? static_cast<double>(v) : d;
+        ++i;
+      });
       have_points = true;
     } else if (key == "CELLS") {
       if (have_cells) in.fail("a second CELLS section");

@@ -7,7 +7,7 @@
 # memory is first touched (1 GiB twice in one process). Every command runs RUNS times (default
 # 3) back to back; report.py shows the median run and the spread. Each refine run starts
 # without its output file: replacing an existing 1 GB file frees its page cache inside the
-# rename (0.4 s here), which is the file system's cost, not the command's. Writes
+# rename, which is the file system's cost, not the command's. Writes
 # results/performance/command.json; report.py turns it into a section of results/performance.md.
 # Needs a Release build (cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && make -C build hexrefine)
 # and about 3 GB of memory and 4 GB of disk in $TMPDIR; about 8 minutes on an idle machine.

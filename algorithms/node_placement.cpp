@@ -23,7 +23,11 @@
 ///     patch, (u, v) in [0,1]^2); on a boundary edge: slides along the input patch edge that
 ///     holds it, or on the input patch if the edge lies inside one (a later pass's edge); input
 ///     nodes never move. So boundary nodes stay on the input's boundary surface, in the input
-///     face they subdivide (the checker's conformity against the input still holds).
+///     face they subdivide (the checker's conformity against the input still holds). In a
+///     later pass the earlier passes' new nodes at the corners of active children are free too
+///     (those on the boundary slide on the input patches of the input hexes around them): they
+///     are new nodes of the refinement, and a transition child of pass 1 refined again in pass
+///     2 otherwise keeps the corners that made it poor, its children compounding the loss.
 ///  3. The problem is local: the hexes around the free nodes are the children of the parents
 ///     around the active ones (node neighbours in the refined mesh), gathered without building
 ///     the output's topology. Serial, worst node first, ties by id: the same result for any
@@ -333,6 +337,34 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
     }
     for (const auto& [node, o] : added) origin_of.try_emplace(node, o);
   }
+  // Earlier passes' new nodes at the corners of the active children (ascending), and the
+  // hexes around them that this pass left untouched: they join the problem (`candidates`).
+  std::vector<int32_t> earlier;
+  if (pass.input_nodes < old_nodes) {
+    for (int32_t c : active)
+      for (int32_t v : refined.hexes[c])
+        if (v >= pass.input_nodes && v < old_nodes) earlier.push_back(v);
+    std::sort(earlier.begin(), earlier.end());
+    earlier.erase(std::unique(earlier.begin(), earlier.end()), earlier.end());
+    // An untouched hex h of `current` is copied to h plus the children beyond one of the
+    // refined hexes before it (plan_apply keeps the input order; uses ascend by hex).
+    std::vector<int32_t> use_hexes(uses.size());
+    for (size_t u = 0; u < uses.size(); ++u) use_hexes[u] = index_of(uses[u].hex);
+    for (int32_t v : earlier)
+      for (int32_t g : node_hexes(topology, v)) {
+        const auto at = std::lower_bound(use_hexes.begin(), use_hexes.end(), g);
+        if (at != use_hexes.end() && *at == g) continue;  // refined: its children are there
+        const size_t k = static_cast<size_t>(at - use_hexes.begin());
+        const int32_t copied = k == 0
+                                   ? g
+                                   : pass.first_child[k - 1] +
+                                         static_cast<int32_t>(uses[k - 1].tmpl->children.size()) +
+                                         (g - use_hexes[k - 1] - 1);
+        candidates.push_back(copied);
+      }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  }
   NodeProblem problem;
   {
     std::vector<int32_t> nodes;
@@ -340,6 +372,31 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
     std::sort(nodes.begin(), nodes.end());
     ReferenceSlides slides(pass.reference, problem.geometry);
     std::vector<int32_t> around;
+    // Earlier passes' nodes first (their ids are below this pass's): on the boundary of
+    // `current`, they slide on the input patches of the input hexes around them.
+    for (int32_t node : earlier) {
+      around.clear();
+      bool boundary = false;
+      for (int32_t g : node_hexes(topology, node)) {
+        around.push_back(original(g));
+        for (int lf = 0; lf < 6 && !boundary; ++lf) {
+          const int32_t f = topology.hex_face_ids[g][lf];
+          if (!face_is_boundary(topology, f)) continue;
+          const auto& q = topology.face_nodes[f];
+          boundary = std::find(q.begin(), q.end(), node) != q.end();
+        }
+      }
+      NodeSlide slide;
+      if (boundary) {
+        std::sort(around.begin(), around.end());
+        around.erase(std::unique(around.begin(), around.end()), around.end());
+        const std::optional<NodeSlide> s = slides.at(refined.points[node], around);
+        if (!s) continue;  // at an input patch corner: stays
+        slide = *s;
+      }
+      problem.nodes.push_back(node);
+      problem.slides.push_back(slide);
+    }
     for (int32_t node : nodes) {
       const NodeOrigin& o = origin_of.at(node);
       const TemplateUse& use = uses[o.use];

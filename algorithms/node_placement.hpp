@@ -123,6 +123,10 @@ struct PlacementPass {
   /// refinement driver then makes them targets and plans the pass again, refiner.cpp).
   bool refuse = true;
   int threads = 1;  ///< for the node optimizer's levels (same result for any count)
+  /// Nodes of the refinement's input (ids below this) never move. A later pass's `current`
+  /// holds the new nodes of the earlier passes (ids from here to current.point_count()): those
+  /// at the corners of the pass's active children move with the pass's new nodes.
+  int32_t input_nodes = 0;
 };
 
 /// Moves the new nodes of `refined` (the pass's output, its nodes from current.point_count() on

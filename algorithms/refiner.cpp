@@ -197,7 +197,8 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
             reference,
             options.allow_inverted,
             attempt == placement_retries,
-            options.threads};
+            options.threads,
+            mesh.point_count()};
         failed = place_new_nodes(placement, applied.mesh, options.placement, stats.placement);
       }
       stats.phase_seconds["placement"] += seconds_since(t);

@@ -456,24 +456,28 @@ def main():
     if quality_plot(groups, os.path.join(args.out, "plots", "quality.png")):
         out.append("### Scaled Jacobian histograms\n\n![quality](plots/quality.png)\n")
 
+    # A saved mesh is rendered; without it (a --resume run that kept its record, on a clone
+    # where the meshes, which are not committed, were never written) the committed render of
+    # the same record stays listed.
     renders = []
     mesh_dir = os.path.dirname(os.path.abspath(args.records))
     for r in recs:
         if "mesh_file" in r:
             src = os.path.join(mesh_dir, r["mesh_file"])
-            if os.path.exists(src):
-                renders.append((r, src))
+            png = os.path.splitext(os.path.basename(src))[0] + ".png"
+            if os.path.exists(src) or os.path.exists(os.path.join(args.out, "renders", png)):
+                renders.append((r, src, png))
     if renders:
         sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
         import render_mesh  # noqa: E402
 
         os.makedirs(os.path.join(args.out, "renders"), exist_ok=True)
         out.append("### Refined meshes (boundary quads coloured by template)\n")
-        for r, src in renders:
-            png = os.path.splitext(os.path.basename(src))[0] + ".png"
-            render_mesh.render(src, os.path.join(args.out, "renders", png),
-                               title="%s, %s: %s hexes" % (r["case"], r["method"],
-                                                           fmt(r.get("final_hexes"))))
+        for r, src, png in renders:
+            if os.path.exists(src):
+                render_mesh.render(src, os.path.join(args.out, "renders", png),
+                                   title="%s, %s: %s hexes" % (r["case"], r["method"],
+                                                               fmt(r.get("final_hexes"))))
             out.append("![%s %s](renders/%s)" % (r["case"], r["method"], png))
         out.append("")
 

@@ -28,6 +28,12 @@
 ///  3. Sweeps, worst node first, nodes whose worst hex is already at or above visit_below left
 ///     alone (a region of good hexes costs one pass), until no move, max_sweeps, or a sweep that
 ///     improves neither the minimum nor the mean.
+///  4. (optimize) Where the sweeps stop, the worst hexes are usually held by several nodes at
+///     once (a transition child whose corners all sit at the minimum, a flat boundary layer that
+///     must thicken as a whole): a joint ascent moves the interior nodes around them together
+///     (node_joint_ascent.hpp), and if it raised the minimum the sweeps run again from there.
+///     On the shared sphere mesh's 1-13 children of flat boundary parents it takes the smoothed
+///     minimum from 0.384 (sweeps alone) to about 0.54.
 
 #include "algorithms/smoothing.hpp"
 
@@ -39,6 +45,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "algorithms/node_joint_ascent.hpp"
 #include "algorithms/node_optimizer.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
@@ -165,6 +172,9 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
                      std::to_string(options.max_sweeps));
   if (options.layers < 0)
     throw InputError("mesh_smooth: layers must be >= 0, got " + std::to_string(options.layers));
+  if (options.joint_iterations < 0)
+    throw InputError("mesh_smooth: joint_iterations must be >= 0, got " +
+                     std::to_string(options.joint_iterations));
   if (!(options.feature_angle_degrees > 0 && options.feature_angle_degrees < 180))
     throw InputError("mesh_smooth: feature angle must be in (0, 180) degrees, got " +
                      std::to_string(options.feature_angle_degrees));
@@ -348,6 +358,9 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
     }
   }
   stats.movable_nodes = static_cast<int64_t>(problem.nodes.size());
+  std::vector<Vec3> start_points;
+  start_points.reserve(problem.nodes.size());
+  for (int32_t v : problem.nodes) start_points.push_back(mesh.points[v]);
   node_problem_connect(problem, mesh, part);
 
   // 3. Sweeps.
@@ -360,9 +373,25 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
   o.ascent_steps = 3;
   o.visit_below = options.visit_below;
   o.threads = options.threads;
-  const NodeOptimizerStats run = nodes_optimize(mesh, problem, o);
+  NodeOptimizerStats run = nodes_optimize(mesh, problem, o);
   stats.sweeps = run.sweeps;
-  stats.nodes_moved = run.nodes_moved;
+  if (options.method == SmoothMethod::optimize && options.max_sweeps > 0 &&
+      options.joint_iterations > 0) {
+    JointAscentOptions joint_options;
+    joint_options.max_iterations = options.joint_iterations;
+    joint_options.threads = options.threads;
+    const JointAscentStats joint = nodes_ascend_jointly(mesh, problem, joint_options);
+    stats.joint_iterations = joint.iterations;
+    // The joint step leaves the sliding nodes where they were and its worst hexes balanced:
+    // node by node, the sweeps can raise the minimum again from there.
+    if (joint.min_after > joint.min_before) {
+      run = nodes_optimize(mesh, problem, o);
+      stats.sweeps += run.sweeps;
+    }
+  }
+  stats.nodes_moved = 0;
+  for (size_t i = 0; i < problem.nodes.size(); ++i)
+    stats.nodes_moved += mesh.points[problem.nodes[i]] != start_points[i];
   min_mean(mesh, stats.min_scaled_jacobian_after, stats.mean_scaled_jacobian_after);
   stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();

@@ -26,7 +26,8 @@ namespace hexrefine {
 enum class SmoothMethod {
   laplacian,  ///< guarded Laplacian: towards the mean of the edge neighbours
   optimize,   ///< guarded Laplacian candidate, then a mean-ratio Newton step, then ascent of the
-              ///< minimum scaled Jacobian of the hexes around the node
+              ///< minimum scaled Jacobian of the hexes around the node; then a joint ascent of
+              ///< the interior nodes around the worst hexes and the sweeps again
 };
 
 /// How smoothing treats a boundary node, from the boundary faces around it.
@@ -51,7 +52,7 @@ SmoothNodeClasses mesh_classify_smooth_nodes(const HexMesh& mesh, const HexTopol
 
 struct SmoothOptions {
   SmoothMethod method = SmoothMethod::optimize;
-  int max_sweeps = 20;  ///< >= 0; 0 only measures
+  int max_sweeps = 20;  ///< >= 0, before the joint ascent and again after it; 0 only measures
   /// Boundary faces whose normals differ by more than this (in (0, 180)) meet at a feature edge.
   double feature_angle_degrees = 30;
   /// Empty: all hexes. Otherwise only the nodes of these hexes move (ids in [0, hex_count)).
@@ -70,6 +71,10 @@ struct SmoothOptions {
   const BoundaryReference* reference = nullptr;
   int32_t reference_nodes = 0;
   int threads = 1;  ///< >= 1: threads for the node visits (the result is the same for any count)
+  /// optimize, >= 0: L-BFGS iterations of the joint ascent of the interior nodes around the
+  /// worst hexes after the sweeps (node_joint_ascent.hpp; 0: none), then the sweeps again if it
+  /// raised the minimum. Not with max_sweeps 0 (which only measures).
+  int joint_iterations = 100;
 };
 
 struct SmoothStats {
@@ -81,14 +86,17 @@ struct SmoothStats {
   int64_t nodes_moved = 0;   ///< nodes whose final position differs from the input
   int64_t region_hexes = 0;  ///< hexes of the region and its layers
   int64_t movable_nodes = 0;
+  int joint_iterations = 0;  ///< iterations of the joint ascent carried out
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SmoothStats, min_scaled_jacobian_before,
                                                 min_scaled_jacobian_after,
                                                 mean_scaled_jacobian_before,
                                                 mean_scaled_jacobian_after, seconds, sweeps,
-                                                nodes_moved, region_hexes, movable_nodes)
+                                                nodes_moved, region_hexes, movable_nodes,
+                                                joint_iterations)
 
-/// Smooths `mesh` in place. Throws InputError for bad options (negative sweeps or layers, feature
+/// Smooths `mesh` in place. Throws InputError for bad options (negative sweeps, layers or joint
+/// iterations, feature
 /// angle outside (0, 180), visit_below outside (0, 1], region hex id out of range) or a mesh
 /// failing mesh_validate_ids or holding a non-finite coordinate. The min and mean before and after
 /// are over the whole mesh.

@@ -1,5 +1,6 @@
 /// \file
 /// `hexrefine smooth IN OUT [--method laplacian|optimize] [--region SPEC ...] [--sweeps N]
+/// [--joint-iterations N]
 /// [--report R.json]`: reads IN, smooths it (algorithms/smoothing.hpp), writes OUT (formats by
 /// extension, mesh/io.hpp) and optionally a JSON report with the minimum and mean scaled Jacobian
 /// before and after, seconds, sweeps and nodes moved.
@@ -50,6 +51,12 @@ int smooth_run(const CliArgs& a) {
       throw InputError("hexrefine smooth: --sweeps must be in 0..1000000, got " + *sweeps);
     options.max_sweeps = static_cast<int>(n);
   }
+  if (const auto joint = a.value("--joint-iterations")) {
+    const long long n = cli_parse_int(*joint, "hexrefine smooth: --joint-iterations");
+    if (n < 0 || n > 1000000)
+      throw InputError("hexrefine smooth: --joint-iterations must be in 0..1000000, got " + *joint);
+    options.joint_iterations = static_cast<int>(n);
+  }
   options.threads = cli_threads(a.value("--threads"));
   const std::vector<std::string> region_specs = a.all("--region");
   const std::optional<std::string> report_path = a.value("--report");
@@ -82,6 +89,7 @@ int smooth_run(const CliArgs& a) {
     report["output"] = out;
     report["method"] = smooth_method_name(options.method);
     report["max_sweeps"] = options.max_sweeps;
+    report["max_joint_iterations"] = options.joint_iterations;
     report["hexes"] = mesh.hex_count();
     report["nodes"] = mesh.point_count();
     report["region"] = region_specs;
@@ -102,7 +110,12 @@ const CliCommand cli_smooth_command = {
     {
         {"--method", "M", "laplacian or optimize (default optimize)"},
         {"--region", "SPEC", "move only the nodes of these hexes (selection specs, united)", true},
-        {"--sweeps", "N", "at most N sweeps, 0..1000000 (default 20)"},
+        {"--sweeps", "N",
+         "at most N sweeps, 0..1000000 (default 20; optimize: N before the joint ascent and N "
+         "after it)"},
+        {"--joint-iterations", "N",
+         "optimize: at most N iterations of the joint ascent of the interior nodes around the "
+         "worst hexes after the sweeps, 0..1000000 (default 100; 0: the sweeps alone)"},
         {"--threads", "N",
          "threads for the node visits, 1..256 (same output; default: every core)"},
         {"--report", "R.json", "write the JSON report"},

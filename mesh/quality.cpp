@@ -178,6 +178,13 @@ void hex_scaled_jacobian_samples(const HexCorners& p, std::array<double, 9>& out
   for (int k = 0; k < 9; ++k) out[k] = samples[k][0];
 }
 
+void hex_scaled_jacobian_samples_pair(const HexCorners& a, const HexCorners& b,
+                                      std::array<double, 9>& out_a, std::array<double, 9>& out_b) {
+  std::array<Lanes, 9> samples;
+  lanes_scaled_jacobian_samples(lanes_corners(a, b), samples);
+  for (int k = 0; k < 9; ++k) out_a[k] = samples[k][0], out_b[k] = samples[k][1];
+}
+
 double hex_scaled_jacobian(const HexCorners& p) {
   return lanes_scaled_jacobian(lanes_corners(p, p))[0];
 }

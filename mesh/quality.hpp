@@ -48,6 +48,10 @@ bool hex_corners_positive(const HexCorners& p);
 /// Unit cube: nine ones.
 void hex_scaled_jacobian_samples(const HexCorners& p, std::array<double, 9>& out);
 
+/// hex_scaled_jacobian_samples of two hexes at once (the kernel's two lanes; the same values).
+void hex_scaled_jacobian_samples_pair(const HexCorners& a, const HexCorners& b,
+                                      std::array<double, 9>& out_a, std::array<double, 9>& out_b);
+
 /// Value returned by unbounded metrics (condition, edge ratio) for degenerate hexes, as Verdict's
 /// VERDICT_DBL_MAX; finite so JSON reports stay valid.
 inline constexpr double hex_metric_max = 1e30;

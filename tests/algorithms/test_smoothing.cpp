@@ -352,7 +352,9 @@ TEST(Smoothing, StatsToJsonCarriesEveryField) {
   s.min_scaled_jacobian_after = 0.3201;
   s.sweeps = 7;
   s.nodes_moved = 42;
+  s.joint_iterations = 63;
   const nlohmann::json j = nlohmann::json(s);
+  EXPECT_EQ(j.at("joint_iterations").get<int>(), 63);
   EXPECT_EQ(j.at("min_scaled_jacobian_before").get<double>(), 0.1856);
   EXPECT_EQ(j.at("min_scaled_jacobian_after").get<double>(), 0.3201);
   EXPECT_EQ(j.at("sweeps").get<int>(), 7);

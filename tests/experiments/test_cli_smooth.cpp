@@ -94,7 +94,8 @@ TEST(CliSmooth, RegionAndSweepsLimitTheMoves) {
   // The brick spans [0,1]^3 (spacing 0.2). Hexes with centroid x <= 0.2: the first layer (25
   // hexes); its nodes have x <= 0.2 + 0.35 * 0.2 = 0.27.
   const CliRun r = cli_run("smooth " + in + " " + out +
-                           " --region box:-1,-1,-1,0.2,2,2 --sweeps 1" + " --report " + report);
+                           " --region box:-1,-1,-1,0.2,2,2 --sweeps 1 --joint-iterations 0" +
+                           " --report " + report);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = read_json(report);
   EXPECT_EQ(j.at("region_hexes").get<int>(), 25);
@@ -136,6 +137,7 @@ TEST(CliSmooth, BadUsageExitsTwoAndWritesNothing) {
       {"smooth " + in + " " + out + " --method newton", "--method"},
       {"smooth " + in + " " + out + " --sweeps -1", "--sweeps"},
       {"smooth " + in + " " + out + " --sweeps many", "--sweeps"},
+      {"smooth " + in + " " + out + " --joint-iterations -3", "--joint-iterations"},
       {"smooth " + in + " " + out + " --region box:1,2", "box"},
       {"smooth " + in + " " + out + " --bogus", "--bogus"},
       {"smooth " + in + " " + (dir / "out.stl").string(), "out.stl"},

@@ -30,9 +30,12 @@
 ///     2 otherwise keeps the corners that made it poor, its children compounding the loss.
 ///  3. The problem is local: the hexes around the free nodes are the children of the parents
 ///     around the active ones (node neighbours in the refined mesh), gathered without building
-///     the output's topology. Serial, worst node first, ties by id: the same result for any
-///     --threads.
-///  4. A child of a valid parent still inverted after the sweeps: its parent is returned, and
+///     the output's topology. Worst node first, ties by id: the same result for any --threads.
+///  4. Where the sweeps stop with every active child valid, a joint ascent of the free interior
+///     nodes around the worst children (node_joint_ascent.hpp: the transition nodes of one
+///     template move together, which one node at a time cannot do when several hold the worst
+///     child at the same value), then the sweeps again if it raised the minimum.
+///  5. A child of a valid parent still inverted after the sweeps: its parent is returned, and
 ///     the driver refines that parent as a target in a new plan of the pass (refiner.cpp); when
 ///     that does not help, a refusal (OperationError naming the input hexes and their scaled
 ///     Jacobians), unless allow_inverted.
@@ -45,6 +48,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "algorithms/node_joint_ascent.hpp"
 #include "algorithms/node_optimizer.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
@@ -431,9 +435,22 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
   optimizer.max_sweeps = options.max_sweeps;
   optimizer.smooth_sweeps = options.smooth_sweeps;
   optimizer.threads = pass.threads;
-  const NodeOptimizerStats run = nodes_optimize(refined, problem, optimizer);
-  stats.sweeps = std::max(stats.sweeps, run.sweeps);
-  stats.nodes_moved += run.nodes_moved;
+  std::vector<Eigen::Vector3d> start_points;
+  start_points.reserve(problem.nodes.size());
+  for (int32_t v : problem.nodes) start_points.push_back(refined.points[v]);
+  int sweeps = nodes_optimize(refined, problem, optimizer).sweeps;
+  if (options.joint_iterations > 0 && optimizer.max_sweeps > 0) {
+    JointAscentOptions joint_options;
+    joint_options.max_iterations = options.joint_iterations;
+    joint_options.threads = pass.threads;
+    const JointAscentStats joint = nodes_ascend_jointly(refined, problem, joint_options);
+    stats.joint_iterations += joint.iterations;
+    if (joint.min_after > joint.min_before)
+      sweeps += nodes_optimize(refined, problem, optimizer).sweeps;
+  }
+  stats.sweeps = std::max(stats.sweeps, sweeps);
+  for (size_t i = 0; i < problem.nodes.size(); ++i)
+    stats.nodes_moved += refined.points[problem.nodes[i]] != start_points[i];
 
   // 4. What is left inverted.
   std::vector<int32_t> failed;

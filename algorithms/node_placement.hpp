@@ -42,9 +42,12 @@ struct PlacementOptions {
   int smooth_sweeps = 0;
   /// Layers of children around the active ones whose new nodes may move too (0, 1, ...).
   int layers = 0;
+  /// >= 0: L-BFGS iterations of the joint ascent after the sweeps (node_joint_ascent.hpp; 0:
+  /// none), then the sweeps again if it raised the minimum.
+  int joint_iterations = 100;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementOptions, method, active_ratio, max_sweeps,
-                                                smooth_sweeps, layers)
+                                                smooth_sweeps, layers, joint_iterations)
 
 struct PlacementStats {
   int64_t active_hexes = 0;  ///< children worked on (all passes)
@@ -53,13 +56,14 @@ struct PlacementStats {
   int64_t inverted_before = 0;  ///< children inverted at their trilinear positions
   int64_t untangled = 0;        ///< of those, the ones placement made valid
   int sweeps = 0;               ///< sweeps carried out (largest over the passes)
+  int joint_iterations = 0;     ///< joint ascent iterations (all passes)
   /// Minimum scaled Jacobian over the active children before and after (1 if none).
   double min_before = 1, min_after = 1;
   double seconds = 0;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementStats, active_hexes, free_nodes,
                                                 nodes_moved, inverted_before, untangled, sweeps,
-                                                min_before, min_after, seconds)
+                                                joint_iterations, min_before, min_after, seconds)
 
 /// The boundary of the input of a refinement (before its first pass) as bilinear patches: where
 /// boundary nodes stay whatever the pass. Patch p is a boundary face of the input, its corners in

@@ -34,7 +34,9 @@ TEST(NodeOptimizer, LevelsReplayTheSerialSweepOnAnyThreadCount) {
     o.method = "selective";
     o.select = {c.select};
     o.smooth = true;
-    o.smoothing.joint_iterations = 0;  // the sweeps alone: the references predate the joint step
+    // The sweeps alone: the references predate the joint ascent.
+    o.refine.placement.joint_iterations = 0;
+    o.smoothing.joint_iterations = 0;
     std::optional<HexMesh> first;
     for (int threads : {1, 2}) {
       SCOPED_TRACE(threads);

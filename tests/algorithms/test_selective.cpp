@@ -348,7 +348,10 @@ TEST(SelectiveCases, SphereRegionsInsideRealMeshes) {
     EXPECT_EQ(c.hanging_nodes, 0) << k.file;
     EXPECT_EQ(c.nonmanifold_faces, 0) << k.file;
     EXPECT_EQ(c.nonmanifold_boundary_edges, 0) << k.file;
-    EXPECT_LT(c.volume_relative_error, 1e-6) << k.file;
+    // New boundary nodes slide on the input's bilinear patches; the refined quads between them
+    // are chords of a warped patch, which changes the volume by about 1e-6 of it (a misplaced
+    // node, or a face of the wrong side, by orders of magnitude more).
+    EXPECT_LT(c.volume_relative_error, 1e-5) << k.file;
     const HexMesh& out = r.mesh;
     const HexTopology ot = topology_build(out);
     EXPECT_TRUE(ot.nonmanifold_faces.empty());

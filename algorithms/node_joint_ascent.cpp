@@ -17,16 +17,20 @@
 ///
 /// Steps:
 ///  1. The variables: the problem's free nodes (interior nodes; sliding nodes keep their place,
-///     their slides are the node-by-node optimizer's). The objective's hexes: those with a free
-///     corner, each with its nine scaled-Jacobian samples (corners, centre: the samples whose
-///     minimum is hex_scaled_jacobian).
-///  2. KS of all those samples and its analytic gradient (hex by hex, the sample gradients of
+///     their slides are the node-by-node optimizer's) of the worst hexes (at most max_seeds of
+///     those within `band` of the worst sample a free node moves) and of `rings` rings of hexes
+///     around them. The objective's hexes: those with a variable corner, with those of their
+///     nine scaled-Jacobian samples (corners, centre: the samples whose minimum is
+///     hex_scaled_jacobian) that a variable moves; a sample no variable moves is a constant.
+///  2. KS of those samples and its analytic gradient (hex by hex, the sample gradients of
 ///     hex_scaled_jacobian_gradients weighted and summed, then gathered node by node).
 ///  3. L-BFGS iterations maximising KS: the two-loop direction (steepest ascent, scaled to move
 ///     the fastest node a fiftieth of the mean edge length, when there is no history or the
 ///     direction does not ascend), every step capped at a quarter of the mean edge length,
 ///     backtracking until the Armijo condition holds; a step that inverts a hex lowers KS
 ///     sharply and is cut back like any other.
+///     They stop after max_iterations, after stall_iterations without the minimum rising, or
+///     when KS stops rising.
 ///  4. The iterate with the highest true minimum is kept; the start if none beats it (checked
 ///     with hex_scaled_jacobian itself).
 /// Threads evaluate chunks of hexes and gather chunks of nodes; every sum is taken in a fixed
@@ -104,6 +108,24 @@ void hex_samples(const Corners& p, std::array<double, 9>& samples,
 
 constexpr int64_t chunk_hexes = 512;
 
+/// The samples of a hex that move when the corners marked in `moves` do: bit v (corner v) when
+/// v or one of its three edge neighbours moves, bit 8 (the centre) when any corner does. A sample
+/// that does not move is a constant of the problem: left out of the objective, its value cannot
+/// hold the ascent back.
+uint16_t sample_mask(const std::array<bool, 8>& moves) {
+  uint16_t mask = 0;
+  for (int v = 0; v < 8; ++v) {
+    bool m = moves[v];
+    for (int k = 0; k < 3; ++k) {
+      const int e = hex_vertex_edges[v][k];
+      m = m || moves[hex_edges[e][0]] || moves[hex_edges[e][1]];
+    }
+    if (m) mask |= static_cast<uint16_t>(1u << v);
+  }
+  if (mask) mask |= 1u << 8;
+  return mask;
+}
+
 /// exp(-z), z >= 0, taken as 0 beyond z = 40 (below 5e-18, nothing next to the minimum's 1):
 /// most samples lie far above the minimum, and their exponentials and gradients are skipped.
 double weight(double z) {
@@ -118,18 +140,33 @@ class JointProblem {
     // The variables: the free nodes of the hexes within options.band of the worst hex with a
     // free corner, and of `rings` rings of hexes around them.
     std::vector<uint8_t> chosen(n, 0);
-    std::vector<double> quality(problem.hexes.size());
+    // Per problem hex its worst sample that a free node moves (1: none).
+    std::vector<double> quality(problem.hexes.size(), 1.0);
     double worst = 1.0;
     for (size_t j = 0; j < problem.hexes.size(); ++j) {
-      quality[j] = hex_scaled_jacobian(hex_points(mesh_, problem.hexes[j]));
-      bool movable = false;
-      for (int32_t i : problem.hex_local_nodes[j])
-        movable = movable || (i >= 0 && problem.slides[i].kind == SlideKind::free);
-      if (movable) worst = std::min(worst, quality[j]);
+      std::array<bool, 8> free{};
+      for (int c = 0; c < 8; ++c) {
+        const int32_t i = problem.hex_local_nodes[j][c];
+        free[c] = i >= 0 && problem.slides[i].kind == SlideKind::free;
+      }
+      const uint16_t mask = sample_mask(free);
+      if (!mask) continue;
+      std::array<double, 9> samples;
+      hex_scaled_jacobian_samples(hex_points(mesh_, problem.hexes[j]), samples);
+      for (int k = 0; k < 9; ++k)
+        if (mask >> k & 1) quality[j] = std::min(quality[j], samples[k]);
+      worst = std::min(worst, quality[j]);
+    }
+    // The seeds: within the band, at most max_seeds of them, the worst first (ties by index).
+    std::vector<std::pair<double, int32_t>> seeds;
+    for (size_t j = 0; j < problem.hexes.size(); ++j)
+      if (quality[j] < worst + options.band) seeds.push_back({quality[j], static_cast<int32_t>(j)});
+    if (static_cast<int64_t>(seeds.size()) > options.max_seeds) {
+      std::nth_element(seeds.begin(), seeds.begin() + options.max_seeds, seeds.end());
+      seeds.resize(static_cast<size_t>(options.max_seeds));
     }
     std::vector<int32_t> front;
-    for (size_t j = 0; j < problem.hexes.size(); ++j) {
-      if (quality[j] >= worst + options.band) continue;
+    for (const auto& [unused, j] : seeds) {
       for (int32_t i : problem.hex_local_nodes[j])
         if (i >= 0 && !chosen[i]) chosen[i] = 1, front.push_back(i);
     }
@@ -156,8 +193,11 @@ class JointProblem {
         any = any || vars[c] >= 0;
       }
       if (!any) continue;
+      std::array<bool, 8> moves;
+      for (int c = 0; c < 8; ++c) moves[c] = vars[c] >= 0;
       hexes_.push_back(problem.hexes[j]);
       hex_vars_.push_back(vars);
+      masks_.push_back(sample_mask(moves));
     }
     // Variable -> (objective hex, corner), CSR, in hex order.
     var_offsets_.assign(nodes_.size() + 1, 0);
@@ -210,10 +250,12 @@ class JointProblem {
         hex_scaled_jacobian_samples_pair(hex_points(mesh_, hexes_[h]), hex_points(mesh_, hexes_[g]),
                                          samples_[h], samples_[g]);
       }
-      for (int64_t h = b; h < e; ++h) {
-        for (double s : samples_[h])
+      for (int64_t h = b; h < e; ++h)
+        for (int k = 0; k < 9; ++k) {
+          if (!(masks_[h] >> k & 1)) continue;
+          const double s = samples_[h][k];
           m = std::isfinite(s) ? std::min(m, s) : -std::numeric_limits<double>::infinity();
-      }
+        }
       chunk_min_[c] = m;
     });
     min = std::numeric_limits<double>::infinity();
@@ -223,7 +265,8 @@ class JointProblem {
     parallel_chunks(threads_, count, chunk_hexes, [&](int64_t c, int64_t b, int64_t e) {
       double sum = 0;
       for (int64_t h = b; h < e; ++h)
-        for (double s : samples_[h]) sum += weight(beta * (s - min));
+        for (int k = 0; k < 9; ++k)
+          if (masks_[h] >> k & 1) sum += weight(beta * (samples_[h][k] - min));
       chunk_sum_[c] = sum;
     });
     double sum = 0;
@@ -244,7 +287,7 @@ class JointProblem {
       for (int64_t h = b; h < e; ++h) {
         bool any = false;
         for (int s = 0; s < 9; ++s) {
-          weights[s] = weight(beta * (samples_[h][s] - min)) / sum;
+          weights[s] = masks_[h] >> s & 1 ? weight(beta * (samples_[h][s] - min)) / sum : 0.0;
           any = any || weights[s] != 0;
         }
         if (any)
@@ -283,10 +326,11 @@ class JointProblem {
  private:
   HexMesh& mesh_;
   const JointAscentOptions& options_;
-  std::vector<int32_t> nodes_;                      // variable -> mesh node
-  std::vector<int32_t> hexes_;                      // objective hexes (mesh ids)
-  std::vector<std::array<int32_t, 8>> hex_vars_;    // per objective hex: corner variables
-  std::vector<int32_t> var_offsets_;                // variable -> var_items_
+  std::vector<int32_t> nodes_;                    // variable -> mesh node
+  std::vector<int32_t> hexes_;                    // objective hexes (mesh ids)
+  std::vector<std::array<int32_t, 8>> hex_vars_;  // per objective hex: corner variables
+  std::vector<uint16_t> masks_;       // per objective hex: its samples that move (sample_mask)
+  std::vector<int32_t> var_offsets_;  // variable -> var_items_
   std::vector<std::pair<int32_t, int>> var_items_;  // (objective hex, corner)
   std::vector<std::array<double, 9>> samples_;      // per objective hex
   std::vector<Corners> hex_gradient_;               // per objective hex, per corner
@@ -316,7 +360,7 @@ JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
   const double cap = 0.25 * joint.mean_edge();
   std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> history;  // (s, y) of -KS
   std::vector<double> alpha;
-  int flat = 0;
+  int flat = 0, since_best = 0;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     // Two-loop recursion on f = -KS (gradient -g): direction d = -H (-g).
     Eigen::VectorXd d = gradient;
@@ -372,10 +416,14 @@ JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
     gradient = std::move(trial_gradient);
     value = trial_value;
     if (trial_min > best_min) {
+      since_best = trial_min > best_min + 1e-5 ? 0 : since_best + 1;
       best_min = trial_min;
       best = x;
+    } else {
+      ++since_best;
     }
-    if (flat >= 5) break;
+    // KS can keep rising by the samples next to the minimum while the minimum itself stays.
+    if (flat >= 5 || since_best >= options.stall_iterations) break;
   }
   joint.set_position(best);
   stats.min_after = joint.true_min();

@@ -20,12 +20,18 @@ struct JointAscentOptions {
   double beta = 60;
   int max_iterations = 100;  ///< >= 0: quasi-Newton iterations (one gradient each)
   int memory = 8;            ///< L-BFGS correction pairs (>= 1)
+  /// >= 1: stop after this many iterations without the minimum rising by 1e-5.
+  int stall_iterations = 30;
   /// The variables are the free nodes of the problem's hexes whose scaled Jacobian is within
   /// `band` (>= 0; 2: every free node) of the worst one with a free corner, and of `rings` rings
   /// of hexes around them: where the KS weights are not negligible, and room for a layer of
   /// hexes to move as a whole.
   double band = 0.25;
-  int rings = 2;    ///< >= 0
+  int rings = 3;  ///< >= 0
+  /// >= 1: at most this many hexes of the band seed the variables, the worst ones: after the
+  /// sweeps many hexes may sit just above the minimum (those the sweeps stopped visiting at
+  /// SmoothOptions::visit_below), and the ascent is for the worst few clusters, not for all.
+  int64_t max_seeds = 64;
   int threads = 1;  ///< >= 1: threads for the hex evaluations (same result for any)
 };
 

@@ -84,6 +84,10 @@ struct NodeOptimizerOptions {
   /// Threads visiting the nodes of one dependency level of a sweep at once (>= 1; the result is
   /// the same for any count).
   int threads = 1;
+  /// Empty, or one flag per problem node: the nodes the first max-min sweep visits (the others
+  /// join when a neighbour moves). A second round after the joint ascent starts from the nodes
+  /// it moved instead of every node the first round already left where it could not improve.
+  std::vector<uint8_t> initially_active;
 };
 
 struct NodeOptimizerStats {
@@ -99,6 +103,11 @@ struct NodeOptimizerStats {
 /// decreases.
 NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
                                   const NodeOptimizerOptions& options);
+
+/// Per problem node: 1 if it, or a problem node sharing a hex with it, is no longer at
+/// `before` (its position per problem node, size problem.nodes.size()).
+std::vector<uint8_t> nodes_moved_and_around(const HexMesh& mesh, const NodeProblem& problem,
+                                            const std::vector<Eigen::Vector3d>& before);
 
 /// Gradients of the nine scaled-Jacobian samples of a hex (hex_scaled_jacobian_samples: corners
 /// 0..7, then the centre) with respect to the position of its local vertex `vertex`.

@@ -443,10 +443,15 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
     JointAscentOptions joint_options;
     joint_options.max_iterations = options.joint_iterations;
     joint_options.threads = pass.threads;
+    std::vector<Eigen::Vector3d> before_joint;
+    before_joint.reserve(problem.nodes.size());
+    for (int32_t v : problem.nodes) before_joint.push_back(refined.points[v]);
     const JointAscentStats joint = nodes_ascend_jointly(refined, problem, joint_options);
     stats.joint_iterations += joint.iterations;
-    if (joint.min_after > joint.min_before)
+    if (joint.min_after > joint.min_before) {
+      optimizer.initially_active = nodes_moved_and_around(refined, problem, before_joint);
       sweeps += nodes_optimize(refined, problem, optimizer).sweeps;
+    }
   }
   stats.sweeps = std::max(stats.sweeps, sweeps);
   for (size_t i = 0; i < problem.nodes.size(); ++i)

@@ -380,11 +380,15 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
     JointAscentOptions joint_options;
     joint_options.max_iterations = options.joint_iterations;
     joint_options.threads = options.threads;
+    std::vector<Vec3> before_joint;
+    before_joint.reserve(problem.nodes.size());
+    for (int32_t v : problem.nodes) before_joint.push_back(mesh.points[v]);
     const JointAscentStats joint = nodes_ascend_jointly(mesh, problem, joint_options);
     stats.joint_iterations = joint.iterations;
     // The joint step leaves the sliding nodes where they were and its worst hexes balanced:
     // node by node, the sweeps can raise the minimum again from there.
     if (joint.min_after > joint.min_before) {
+      o.initially_active = nodes_moved_and_around(mesh, problem, before_joint);
       run = nodes_optimize(mesh, problem, o);
       stats.sweeps += run.sweeps;
     }

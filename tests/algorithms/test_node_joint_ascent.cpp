@@ -138,6 +138,7 @@ TEST(NodeJointAscent, SameMeshOnAnyThreadCount) {
     HexMesh m = refined;
     JointAscentOptions options;
     options.band = 2;  // every free node
+    options.max_seeds = 1 << 30;
     options.max_iterations = 15;
     options.threads = threads;
     const JointAscentStats stats = nodes_ascend_jointly(m, problem, options);

@@ -9,7 +9,9 @@
 #include <optional>
 
 #include "algorithms/pipeline.hpp"
+#include "fixtures.hpp"
 #include "mesh/io.hpp"
+#include "mesh/quality.hpp"
 #include "tests/cli_runner.hpp"
 
 namespace hexrefine {
@@ -51,6 +53,31 @@ TEST(NodeOptimizer, LevelsReplayTheSerialSweepOnAnyThreadCount) {
         EXPECT_EQ(r.mesh.points, first->points);
     }
   }
+}
+
+// A second round after the joint ascent starts from the nodes it moved: the first sweep visits
+// only the flagged nodes, and a node no neighbour of which moves is never visited.
+TEST(NodeOptimizer, InitiallyActiveNodesAreTheOnlyOnesTheFirstSweepVisits) {
+  HexMesh brick = fixture_brick(3, 3, 3);
+  // The two interior nodes of the brick's middle row, each pushed off its place.
+  const int32_t a = 1 + 4 * 1 + 16 * 1, b = 2 + 4 * 1 + 16 * 1;
+  brick.points[a] += Eigen::Vector3d(0.3, 0.2, 0.1);
+  brick.points[b] += Eigen::Vector3d(-0.2, 0.3, 0.1);
+  NodeProblem problem;
+  problem.nodes = {a, b};
+  problem.slides.resize(2);
+  std::vector<int32_t> all(brick.hexes.size());
+  for (int32_t h = 0; h < brick.hex_count(); ++h) all[h] = h;
+  node_problem_connect(problem, brick, all);
+  NodeOptimizerOptions o;
+  o.initially_active = {0, 0};
+  HexMesh none = brick;
+  EXPECT_EQ(nodes_optimize(none, problem, o).nodes_moved, 0);
+  EXPECT_EQ(none.points, brick.points);
+  o.initially_active = {1, 0};  // a moves, which wakes b (they share hexes)
+  HexMesh one = brick;
+  EXPECT_EQ(nodes_optimize(one, problem, o).nodes_moved, 2);
+  EXPECT_GT(mesh_min_scaled_jacobian(one), mesh_min_scaled_jacobian(brick));
 }
 
 }  // namespace

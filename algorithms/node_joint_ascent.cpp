@@ -137,11 +137,11 @@ class JointProblem {
   JointProblem(HexMesh& mesh, const NodeProblem& problem, const JointAscentOptions& options)
       : mesh_(mesh), options_(options) {
     const int32_t n = static_cast<int32_t>(problem.nodes.size());
-    // The variables: the free nodes of the hexes within options.band of the worst hex with a
-    // free corner, and of `rings` rings of hexes around them.
+    // The variables: the free nodes of the worst hexes within options.band of the worst sample a
+    // free node moves, and of `rings` rings of hexes around them.
     std::vector<uint8_t> chosen(n, 0);
-    // Per problem hex its worst sample that a free node moves (1: none).
-    std::vector<double> quality(problem.hexes.size(), 1.0);
+    // Per problem hex its worst sample that a free node moves (2: none, never a seed).
+    std::vector<double> quality(problem.hexes.size(), 2.0);
     double worst = 1.0;
     for (size_t j = 0; j < problem.hexes.size(); ++j) {
       std::array<bool, 8> free{};
@@ -160,7 +160,8 @@ class JointProblem {
     // The seeds: within the band, at most max_seeds of them, the worst first (ties by index).
     std::vector<std::pair<double, int32_t>> seeds;
     for (size_t j = 0; j < problem.hexes.size(); ++j)
-      if (quality[j] < worst + options.band) seeds.push_back({quality[j], static_cast<int32_t>(j)});
+      if (quality[j] <= 1.0 && quality[j] < worst + options.band)
+        seeds.push_back({quality[j], static_cast<int32_t>(j)});
     if (static_cast<int64_t>(seeds.size()) > options.max_seeds) {
       std::nth_element(seeds.begin(), seeds.begin() + options.max_seeds, seeds.end());
       seeds.resize(static_cast<size_t>(options.max_seeds));

@@ -340,7 +340,39 @@ class JointProblem {
   int threads_ = 1;
 };
 
+/// Per problem node: 1 if it, or a problem node sharing a hex with it, is no longer at
+/// `before` (per problem node).
+std::vector<uint8_t> nodes_moved_and_around(const HexMesh& mesh, const NodeProblem& problem,
+                                            const std::vector<Vec3>& before) {
+  const size_t n = problem.nodes.size();
+  std::vector<uint8_t> out(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    if (mesh.points[problem.nodes[i]] == before[i]) continue;
+    for (int32_t k = problem.node_hex_offsets[i]; k < problem.node_hex_offsets[i + 1]; ++k)
+      for (int32_t j : problem.hex_local_nodes[problem.node_hex[k]])
+        if (j >= 0) out[j] = 1;
+  }
+  return out;
+}
+
 }  // namespace
+
+SweepsAndAscentStats nodes_sweep_and_ascend(HexMesh& mesh, const NodeProblem& problem,
+                                            NodeOptimizerOptions sweeps,
+                                            const JointAscentOptions& joint) {
+  SweepsAndAscentStats stats;
+  stats.sweeps = nodes_optimize(mesh, problem, sweeps).sweeps;
+  if (sweeps.max_sweeps <= 0 || joint.max_iterations <= 0) return stats;
+  std::vector<Vec3> before;
+  before.reserve(problem.nodes.size());
+  for (int32_t v : problem.nodes) before.push_back(mesh.points[v]);
+  const JointAscentStats ascent = nodes_ascend_jointly(mesh, problem, joint);
+  stats.joint_iterations = ascent.iterations;
+  if (!(ascent.min_after > ascent.min_before)) return stats;
+  sweeps.initially_active = nodes_moved_and_around(mesh, problem, before);
+  stats.sweeps += nodes_optimize(mesh, problem, sweeps).sweeps;
+  return stats;
+}
 
 JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
                                       const JointAscentOptions& options) {

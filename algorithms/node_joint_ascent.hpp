@@ -52,4 +52,19 @@ struct JointAscentStats {
 JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
                                       const JointAscentOptions& options);
 
+struct SweepsAndAscentStats {
+  int sweeps = 0;            ///< of both rounds
+  int joint_iterations = 0;  ///< of the joint ascent (0 if it did not run)
+};
+
+/// What node placement and smoothing both do: nodes_optimize with `sweeps`; then, unless
+/// sweeps.max_sweeps or joint.max_iterations is 0, nodes_ascend_jointly; and if that raised the
+/// minimum, nodes_optimize again, its first sweep visiting only the nodes the ascent moved and
+/// those sharing a hex with them (the others are where the first round left them). The joint
+/// ascent leaves the sliding nodes where they were and its worst hexes balanced: node by node,
+/// the sweeps can raise the minimum again from there.
+SweepsAndAscentStats nodes_sweep_and_ascend(HexMesh& mesh, const NodeProblem& problem,
+                                            NodeOptimizerOptions sweeps,
+                                            const JointAscentOptions& joint);
+
 }  // namespace hexrefine

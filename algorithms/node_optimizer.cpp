@@ -102,19 +102,6 @@ void hex_scaled_jacobian_gradients(const std::array<Vec3, 8>& p, int vertex,
   sample(a, c, 8);
 }
 
-std::vector<uint8_t> nodes_moved_and_around(const HexMesh& mesh, const NodeProblem& problem,
-                                            const std::vector<Vec3>& before) {
-  const size_t n = problem.nodes.size();
-  std::vector<uint8_t> out(n, 0);
-  for (size_t i = 0; i < n; ++i) {
-    if (mesh.points[problem.nodes[i]] == before[i]) continue;
-    for (int32_t k = problem.node_hex_offsets[i]; k < problem.node_hex_offsets[i + 1]; ++k)
-      for (int32_t j : problem.hex_local_nodes[problem.node_hex[k]])
-        if (j >= 0) out[j] = 1;
-  }
-  return out;
-}
-
 void node_problem_connect(NodeProblem& problem, const HexMesh& mesh,
                           const std::vector<int32_t>& candidates) {
   const int32_t n = static_cast<int32_t>(problem.nodes.size());

@@ -104,11 +104,6 @@ struct NodeOptimizerStats {
 NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
                                   const NodeOptimizerOptions& options);
 
-/// Per problem node: 1 if it, or a problem node sharing a hex with it, is no longer at
-/// `before` (its position per problem node, size problem.nodes.size()).
-std::vector<uint8_t> nodes_moved_and_around(const HexMesh& mesh, const NodeProblem& problem,
-                                            const std::vector<Eigen::Vector3d>& before);
-
 /// Gradients of the nine scaled-Jacobian samples of a hex (hex_scaled_jacobian_samples: corners
 /// 0..7, then the centre) with respect to the position of its local vertex `vertex`.
 /// Sample s = det(A) / (|a0| |a1| |a2|), column k of A = c_k x + const (c_k in {-1, -1/4, 0,

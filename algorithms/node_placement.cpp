@@ -438,22 +438,13 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
   std::vector<Eigen::Vector3d> start_points;
   start_points.reserve(problem.nodes.size());
   for (int32_t v : problem.nodes) start_points.push_back(refined.points[v]);
-  int sweeps = nodes_optimize(refined, problem, optimizer).sweeps;
-  if (options.joint_iterations > 0 && optimizer.max_sweeps > 0) {
-    JointAscentOptions joint_options;
-    joint_options.max_iterations = options.joint_iterations;
-    joint_options.threads = pass.threads;
-    std::vector<Eigen::Vector3d> before_joint;
-    before_joint.reserve(problem.nodes.size());
-    for (int32_t v : problem.nodes) before_joint.push_back(refined.points[v]);
-    const JointAscentStats joint = nodes_ascend_jointly(refined, problem, joint_options);
-    stats.joint_iterations += joint.iterations;
-    if (joint.min_after > joint.min_before) {
-      optimizer.initially_active = nodes_moved_and_around(refined, problem, before_joint);
-      sweeps += nodes_optimize(refined, problem, optimizer).sweeps;
-    }
-  }
-  stats.sweeps = std::max(stats.sweeps, sweeps);
+  JointAscentOptions joint_options;
+  joint_options.max_iterations = options.joint_iterations;
+  joint_options.threads = pass.threads;
+  const SweepsAndAscentStats run =
+      nodes_sweep_and_ascend(refined, problem, optimizer, joint_options);
+  stats.sweeps = std::max(stats.sweeps, run.sweeps);
+  stats.joint_iterations += run.joint_iterations;
   for (size_t i = 0; i < problem.nodes.size(); ++i)
     stats.nodes_moved += refined.points[problem.nodes[i]] != start_points[i];
 

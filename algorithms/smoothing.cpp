@@ -373,26 +373,13 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
   o.ascent_steps = 3;
   o.visit_below = options.visit_below;
   o.threads = options.threads;
-  NodeOptimizerStats run = nodes_optimize(mesh, problem, o);
+  JointAscentOptions joint_options;
+  joint_options.max_iterations =
+      options.method == SmoothMethod::optimize ? options.joint_iterations : 0;
+  joint_options.threads = options.threads;
+  const SweepsAndAscentStats run = nodes_sweep_and_ascend(mesh, problem, o, joint_options);
   stats.sweeps = run.sweeps;
-  if (options.method == SmoothMethod::optimize && options.max_sweeps > 0 &&
-      options.joint_iterations > 0) {
-    JointAscentOptions joint_options;
-    joint_options.max_iterations = options.joint_iterations;
-    joint_options.threads = options.threads;
-    std::vector<Vec3> before_joint;
-    before_joint.reserve(problem.nodes.size());
-    for (int32_t v : problem.nodes) before_joint.push_back(mesh.points[v]);
-    const JointAscentStats joint = nodes_ascend_jointly(mesh, problem, joint_options);
-    stats.joint_iterations = joint.iterations;
-    // The joint step leaves the sliding nodes where they were and its worst hexes balanced:
-    // node by node, the sweeps can raise the minimum again from there.
-    if (joint.min_after > joint.min_before) {
-      o.initially_active = nodes_moved_and_around(mesh, problem, before_joint);
-      run = nodes_optimize(mesh, problem, o);
-      stats.sweeps += run.sweeps;
-    }
-  }
+  stats.joint_iterations = run.joint_iterations;
   stats.nodes_moved = 0;
   for (size_t i = 0; i < problem.nodes.size(); ++i)
     stats.nodes_moved += mesh.points[problem.nodes[i]] != start_points[i];

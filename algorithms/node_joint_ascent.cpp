@@ -31,6 +31,8 @@
 ///     sharply and is cut back like any other.
 ///     They stop after max_iterations, after stall_iterations without the minimum rising, or
 ///     when KS stops rising.
+///     An iterate that stretches a hex past its edge-ratio cap (hex_edge_ratio_cap) is
+///     infeasible: its KS is -inf, and the line search cuts the step back as for an inversion.
 ///  4. The iterate with the highest true minimum is kept; the start if none beats it (checked
 ///     with hex_scaled_jacobian itself).
 /// Threads evaluate chunks of hexes and gather chunks of nodes; every sum is taken in a fixed
@@ -197,6 +199,8 @@ class JointProblem {
       std::array<bool, 8> moves;
       for (int c = 0; c < 8; ++c) moves[c] = vars[c] >= 0;
       hexes_.push_back(problem.hexes[j]);
+      edge_caps_.push_back(
+          hex_edge_ratio_cap(hex_points(mesh_, problem.hexes[j]), options.max_edge_ratio));
       hex_vars_.push_back(vars);
       masks_.push_back(sample_mask(moves));
     }
@@ -239,7 +243,8 @@ class JointProblem {
     for (size_t v = 0; v < nodes_.size(); ++v) mesh_.points[nodes_[v]] = x.segment<3>(3 * v);
   }
 
-  /// At x: KS (-inf where a sample is not finite), the minimum sample and, with `gradient`,
+  /// At x: KS (-inf where a sample is not finite or a hex is past its edge-ratio cap: an
+  /// infeasible point), the minimum sample and, with `gradient`,
   /// d KS / d x.
   double evaluate(const Eigen::VectorXd& x, double& min, Eigen::VectorXd* gradient) {
     set_position(x);
@@ -251,12 +256,16 @@ class JointProblem {
         hex_scaled_jacobian_samples_pair(hex_points(mesh_, hexes_[h]), hex_points(mesh_, hexes_[g]),
                                          samples_[h], samples_[g]);
       }
-      for (int64_t h = b; h < e; ++h)
+      for (int64_t h = b; h < e; ++h) {
         for (int k = 0; k < 9; ++k) {
           if (!(masks_[h] >> k & 1)) continue;
           const double s = samples_[h][k];
           m = std::isfinite(s) ? std::min(m, s) : -std::numeric_limits<double>::infinity();
         }
+        // Past its edge-ratio cap a hex makes the point infeasible, like a non-finite sample.
+        if (!(hex_edge_ratio(hex_points(mesh_, hexes_[h])) <= edge_caps_[h]))
+          m = -std::numeric_limits<double>::infinity();
+      }
       chunk_min_[c] = m;
     });
     min = std::numeric_limits<double>::infinity();
@@ -329,6 +338,7 @@ class JointProblem {
   const JointAscentOptions& options_;
   std::vector<int32_t> nodes_;                    // variable -> mesh node
   std::vector<int32_t> hexes_;                    // objective hexes (mesh ids)
+  std::vector<double> edge_caps_;                 // per objective hex: hex_edge_ratio_cap
   std::vector<std::array<int32_t, 8>> hex_vars_;  // per objective hex: corner variables
   std::vector<uint16_t> masks_;       // per objective hex: its samples that move (sample_mask)
   std::vector<int32_t> var_offsets_;  // variable -> var_items_
@@ -389,6 +399,7 @@ JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
   Eigen::VectorXd x = start, gradient, best = start;
   double min, best_min;
   double value = joint.evaluate(x, min, &gradient);
+  if (!std::isfinite(value)) return stats;  // the start past a cap: nothing to ascend from
   best_min = min;
   const double cap = 0.25 * joint.mean_edge();
   std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> history;  // (s, y) of -KS

@@ -32,6 +32,9 @@ struct JointAscentOptions {
   /// sweeps many hexes may sit just above the minimum (those the sweeps stopped visiting at
   /// SmoothOptions::visit_below), and the ascent is for the worst few clusters, not for all.
   int64_t max_seeds = 64;
+  /// No iterate may give an objective hex an edge ratio above hex_edge_ratio_cap(its start,
+  /// max_edge_ratio) (node_optimizer.hpp; <= 0: no cap): such an iterate is infeasible.
+  double max_edge_ratio = 20;
   int threads = 1;  ///< >= 1: threads for the hex evaluations (same result for any)
 };
 

@@ -102,6 +102,11 @@ void hex_scaled_jacobian_gradients(const std::array<Vec3, 8>& p, int vertex,
   sample(a, c, 8);
 }
 
+double hex_edge_ratio_cap(const HexCorners& p, double limit) {
+  if (!(limit > 0)) return std::numeric_limits<double>::infinity();
+  return std::max(limit, hex_edge_ratio(p) * (1 + 1e-9));
+}
+
 void node_problem_connect(NodeProblem& problem, const HexMesh& mesh,
                           const std::vector<int32_t>& candidates) {
   const int32_t n = static_cast<int32_t>(problem.nodes.size());
@@ -134,18 +139,13 @@ void node_problem_connect(NodeProblem& problem, const HexMesh& mesh,
 
 namespace {
 
-/// Where a sliding node is: its item (patch or segment id) and parameters.
-struct SlideState {
-  int32_t item = -1;
-  double u = 0.5, v = 0.5;
-};
-
 /// What the workers of one nodes_optimize call share: per problem hex its scaled Jacobian, per
 /// movable node its start and slide state, and the phase. A worker writes only the entries of the
 /// node it visits and of the hexes around it, so workers visiting nodes that share no hex never
 /// touch the same entry.
 struct OptimizerShared {
   std::vector<double> quality;
+  std::vector<double> edge_cap;  // per problem hex: hex_edge_ratio_cap
   std::vector<Vec3> start;
   std::vector<SlideState> state;
   bool soft_phase = false;
@@ -174,6 +174,10 @@ class Optimizer {
     if (!initialize) return;
     quality_.resize(problem.hexes.size());
     mesh_scaled_jacobians(mesh, problem.hexes, quality_);
+    shared.edge_cap.resize(problem.hexes.size());
+    for (size_t k = 0; k < problem.hexes.size(); ++k)
+      shared.edge_cap[k] =
+          hex_edge_ratio_cap(hex_points(mesh, problem.hexes[k]), options.max_edge_ratio);
     state_.resize(problem.nodes.size());
     start_.resize(problem.nodes.size());
     for (size_t i = 0; i < problem.nodes.size(); ++i) start_[i] = mesh.points[problem.nodes[i]];
@@ -234,39 +238,10 @@ class Optimizer {
 
   const NodeSlide& slide(int32_t i) const { return problem_.slides[i]; }
 
-  /// The point of the slide of node i nearest to x, and the state there.
+  /// The point of the slide of node i nearest to x, and the state there (`s` starts as the
+  /// node's current state: the projection's warm start).
   Vec3 slide_project(int32_t i, const Vec3& x, SlideState& s) const {
-    const NodeSlide& sl = slide(i);
-    const SlideGeometry& g = problem_.geometry;
-    if (sl.kind == SlideKind::free) return x;
-    double best = std::numeric_limits<double>::infinity();
-    Vec3 out = x;
-    for (int32_t k = sl.first; k < sl.first + sl.count; ++k) {
-      const int32_t item = g.items[k];
-      if (sl.kind == SlideKind::patch || sl.kind == SlideKind::patches) {
-        const bool same = item == state_[i].item;
-        const QuadProjection p = quad_closest_point(g.patches[item], x, same ? state_[i].u : 0.5,
-                                                    same ? state_[i].v : 0.5);
-        if (p.distance < best) {
-          best = p.distance;
-          out = p.point;
-          s = {item, p.u, p.v};
-        }
-      } else {
-        const Vec3& a = g.segments[item][0];
-        const Vec3 d = g.segments[item][1] - a;
-        const double len2 = d.squaredNorm();
-        const double t = len2 > 0 ? std::clamp((x - a).dot(d) / len2, 0.0, 1.0) : 0.0;
-        const Vec3 p = a + t * d;
-        const double dist = (p - x).norm();
-        if (dist < best) {
-          best = dist;
-          out = p;
-          s = {item, t, 0.0};
-        }
-      }
-    }
-    return out;
+    return hexrefine::slide_project(slide(i), problem_.geometry, x, s);
   }
 
   /// Puts node i on its slide (the position it starts from).
@@ -285,21 +260,7 @@ class Optimizer {
 
   /// The gradient g projected onto the tangent of node i's slide at its current state.
   Vec3 slide_tangent(int32_t i, const Vec3& g) const {
-    const NodeSlide& sl = slide(i);
-    const SlideGeometry& geo = problem_.geometry;
-    const SlideState& s = state_[i];
-    if (sl.kind == SlideKind::free || s.item < 0) return g;
-    if (sl.kind == SlideKind::patch || sl.kind == SlideKind::patches) {
-      const auto [su, sv] = quad_tangents(geo.patches[s.item], s.u, s.v);
-      Eigen::Matrix<double, 3, 2> j;
-      j.col(0) = su;
-      j.col(1) = sv;
-      const Eigen::Matrix2d jtj = j.transpose() * j;
-      if (!(std::abs(jtj.determinant()) > 1e-300)) return Vec3::Zero();
-      return j * jtj.inverse() * (j.transpose() * g);
-    }
-    const Vec3 d = (geo.segments[s.item][1] - geo.segments[s.item][0]).normalized();
-    return d.dot(g) * d;
+    return hexrefine::slide_tangent(slide(i), problem_.geometry, state_[i], g);
   }
 
   // --- guard -------------------------------------------------------------------------------
@@ -327,6 +288,10 @@ class Optimizer {
             hex_points(mesh_, problem_.hexes[local_hex]),
             hex_points(mesh_, problem_.hexes[problem_.node_hex[std::min(k + 1, end - 1)]]));
       const double q = pair[(k - first) % 2];
+      // A hex stretched past its edge-ratio cap counts as inverted: not allowed.
+      if (!(hex_edge_ratio(hex_points(mesh_, problem_.hexes[local_hex])) <=
+            shared_.edge_cap[local_hex]))
+        allowed = false;
       trial_[t++] = q;
       local_min = std::min(local_min, q);
       gain += q - quality_[local_hex];

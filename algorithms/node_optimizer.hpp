@@ -1,42 +1,19 @@
 #pragma once
 /// \file
 /// Local node optimization shared by node placement (node_placement.hpp) and smoothing
-/// (smoothing.hpp): a set of movable nodes, the hexes around each, how each may move (freely, on
-/// a bilinear patch of the input's boundary, along a straight boundary edge, or on a union of
-/// them), and Gauss-Seidel sweeps that move one node at a time to raise the worst scaled Jacobian
-/// of the hexes around it. See node_optimizer.cpp for the objective and its sources.
+/// (smoothing.hpp): a set of movable nodes, the hexes around each, how each may move
+/// (node_slide.hpp), and Gauss-Seidel sweeps that move one node at a time to raise the worst scaled
+/// Jacobian of the hexes around it. See node_optimizer.cpp for the objective and its sources.
 
 #include <array>
 #include <cstdint>
 #include <vector>
 
+#include "algorithms/node_slide.hpp"
 #include "mesh/hex_mesh.hpp"
-#include "mesh/quad_patch.hpp"
+#include "mesh/quality.hpp"
 
 namespace hexrefine {
-
-/// How a movable node may move.
-enum class SlideKind : uint8_t {
-  free,      ///< anywhere: a node inside the domain
-  patch,     ///< on one bilinear patch (a quad of the input's boundary), (u, v) in [0,1]^2
-  segment,   ///< on one straight segment (an edge of the input's boundary), t in [0,1]
-  patches,   ///< on the union of several patches (the boundary quads around a node)
-  segments,  ///< on the union of several segments (a feature curve's edges around a node)
-};
-
-/// The slide of one node: its kind and its patches or segments (SlideGeometry::items[first ..
-/// first + count)).
-struct NodeSlide {
-  SlideKind kind = SlideKind::free;
-  int32_t first = 0, count = 0;
-};
-
-/// What nodes slide on: reference positions, fixed while the nodes move.
-struct SlideGeometry {
-  std::vector<Quad> patches;
-  std::vector<std::array<Eigen::Vector3d, 2>> segments;
-  std::vector<int32_t> items;  ///< patch or segment ids of the slides
-};
 
 /// A local problem: movable nodes, how each slides, the hexes around each.
 struct NodeProblem {
@@ -50,6 +27,12 @@ struct NodeProblem {
   std::vector<std::array<int32_t, 8>> hex_local_nodes;
   SlideGeometry geometry;
 };
+
+/// The largest edge ratio a move may give the hex with corners p (its start):
+/// max(limit, hex_edge_ratio(p) (1 + 1e-9)), so that a hex already stretched beyond the limit
+/// (an anisotropic parent's child) may stay as it is (up to the rounding of a node projected
+/// back onto its slide) but not get worse; +inf when limit <= 0.
+double hex_edge_ratio_cap(const HexCorners& p, double limit);
 
 /// Fills problem.hexes, the node -> hex CSR and hex_local_nodes from `candidates` (ascending hex
 /// ids that include
@@ -68,6 +51,16 @@ struct NodeOptimizerOptions {
   bool ascent = true;
   /// Nodes whose worst hex is at or above this are not visited (in (0, 1]; 1: every node).
   double visit_below = 1.0;
+  /// No move may give a hex an edge ratio (hex_edge_ratio) above hex_edge_ratio_cap(its start,
+  /// max_edge_ratio) (<= 0: no cap). The scaled Jacobian is blind to edge length: maximising its
+  /// minimum alone pulls two new nodes of a transition together until their edge is a
+  /// thousandth of the others (the shared rocker arm's sphere:0,0,0,5, selective: edges of 0.3
+  /// down to 3e-4, a largest edge ratio of 4,331 where the trilinear positions give 15), hexes
+  /// fine by their angles and useless to an analysis. 20 (PlacementOptions and SmoothOptions
+  /// too): above what the templates give the children of the shared meshes' parents (8 on the
+  /// sphere's 2:1 boundary parents, 15 on the rocker arm's); on the real-mesh study's cases, 10
+  /// gave up a quarter more of the scaled Jacobian and 30 little more than 20.
+  double max_edge_ratio = 20;
   /// Never turn a hex with a positive scaled Jacobian non-positive (smoothing). false: an
   /// inverted hex may be traded for a less inverted one while untangling (placement), as long
   /// as the worst hex around the node improves.

@@ -435,12 +435,14 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
   optimizer.max_sweeps = options.max_sweeps;
   optimizer.smooth_sweeps = options.smooth_sweeps;
   optimizer.threads = pass.threads;
+  optimizer.max_edge_ratio = options.max_edge_ratio;
   std::vector<Eigen::Vector3d> start_points;
   start_points.reserve(problem.nodes.size());
   for (int32_t v : problem.nodes) start_points.push_back(refined.points[v]);
   JointAscentOptions joint_options;
   joint_options.max_iterations = options.joint_iterations;
   joint_options.threads = pass.threads;
+  joint_options.max_edge_ratio = options.max_edge_ratio;
   const SweepsAndAscentStats run =
       nodes_sweep_and_ascend(refined, problem, optimizer, joint_options);
   stats.sweeps = std::max(stats.sweeps, run.sweeps);

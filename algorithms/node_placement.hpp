@@ -45,9 +45,13 @@ struct PlacementOptions {
   /// >= 0: L-BFGS iterations of the joint ascent after the sweeps (node_joint_ascent.hpp; 0:
   /// none), then the sweeps again if it raised the minimum.
   int joint_iterations = 100;
+  /// No move gives a hex an edge ratio above max(max_edge_ratio, its ratio at the trilinear
+  /// positions) (NodeOptimizerOptions::max_edge_ratio; <= 0: no cap, the scaled Jacobian alone).
+  double max_edge_ratio = 20;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementOptions, method, active_ratio, max_sweeps,
-                                                smooth_sweeps, layers, joint_iterations)
+                                                smooth_sweeps, layers, joint_iterations,
+                                                max_edge_ratio)
 
 struct PlacementStats {
   int64_t active_hexes = 0;  ///< children worked on (all passes)

@@ -373,7 +373,9 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
   o.ascent_steps = 3;
   o.visit_below = options.visit_below;
   o.threads = options.threads;
+  o.max_edge_ratio = options.max_edge_ratio;
   JointAscentOptions joint_options;
+  joint_options.max_edge_ratio = options.max_edge_ratio;
   joint_options.max_iterations =
       options.method == SmoothMethod::optimize ? options.joint_iterations : 0;
   joint_options.threads = options.threads;

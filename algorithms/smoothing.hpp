@@ -75,6 +75,9 @@ struct SmoothOptions {
   /// worst hexes after the sweeps (node_joint_ascent.hpp; 0: none), then the sweeps again if it
   /// raised the minimum. Not with max_sweeps 0 (which only measures).
   int joint_iterations = 100;
+  /// No move gives a hex an edge ratio above max(max_edge_ratio, its ratio before smoothing)
+  /// (NodeOptimizerOptions::max_edge_ratio; <= 0: no cap, the scaled Jacobian alone).
+  double max_edge_ratio = 20;
 };
 
 struct SmoothStats {

@@ -77,6 +77,14 @@ int refine_run(const CliArgs& a) {
                        "'");
   }
   o.smooth = a.flag("--smooth");
+  if (const auto r = a.value("--max-edge-ratio")) {
+    const double cap = cli_parse_double(*r, "hexrefine refine: --max-edge-ratio");
+    if (!(cap == 0 || (cap >= 1 && cap <= 1e6)))
+      throw InputError("hexrefine refine: --max-edge-ratio must be 0 or in 1..1e6, got '" + *r +
+                       "'");
+    o.refine.placement.max_edge_ratio = cap;
+    o.smoothing.max_edge_ratio = cap;
+  }
   if (const auto m = a.value("--max-hexes"))
     o.max_hexes = cli_parse_int_in(*m, 1, std::numeric_limits<int32_t>::max(), "--max-hexes");
   if (a.flag("--verbose")) o.verbose = &std::cerr;
@@ -139,6 +147,9 @@ const CliCommand cli_refine_command = {
          "new nodes: trilinear (the thesis' positions) or optimized "
          "(default: raise the worst scaled Jacobian, untangle)"},
         {"--smooth", "", "smooth the refined region afterwards (checked again)"},
+        {"--max-edge-ratio", "R",
+         "optimized placement and --smooth give no hex an edge ratio above R or its ratio before "
+         "(default 20; 0: no cap, the scaled Jacobian alone)"},
         {"--no-ranking", "", "ablation: selective without its ranking system"},
         {"--directional-order", "ORDER",
          "selective: by-hex (default: the thesis' hex after hex) or by-rank (a rank per step)"},

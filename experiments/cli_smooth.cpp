@@ -57,6 +57,13 @@ int smooth_run(const CliArgs& a) {
       throw InputError("hexrefine smooth: --joint-iterations must be in 0..1000000, got " + *joint);
     options.joint_iterations = static_cast<int>(n);
   }
+  if (const auto r = a.value("--max-edge-ratio")) {
+    const double cap = cli_parse_double(*r, "hexrefine smooth: --max-edge-ratio");
+    if (!(cap == 0 || (cap >= 1 && cap <= 1e6)))
+      throw InputError("hexrefine smooth: --max-edge-ratio must be 0 or in 1..1e6, got '" + *r +
+                       "'");
+    options.max_edge_ratio = cap;
+  }
   options.threads = cli_threads(a.value("--threads"));
   const std::vector<std::string> region_specs = a.all("--region");
   const std::optional<std::string> report_path = a.value("--report");
@@ -90,6 +97,7 @@ int smooth_run(const CliArgs& a) {
     report["method"] = smooth_method_name(options.method);
     report["max_sweeps"] = options.max_sweeps;
     report["max_joint_iterations"] = options.joint_iterations;
+    report["max_edge_ratio"] = options.max_edge_ratio;
     report["hexes"] = mesh.hex_count();
     report["nodes"] = mesh.point_count();
     report["region"] = region_specs;
@@ -116,6 +124,9 @@ const CliCommand cli_smooth_command = {
         {"--joint-iterations", "N",
          "optimize: at most N iterations of the joint ascent of the interior nodes around the "
          "worst hexes after the sweeps, 0..1000000 (default 100; 0: the sweeps alone)"},
+        {"--max-edge-ratio", "R",
+         "give no hex an edge ratio above R or its ratio before (default 20; 0: no cap, the "
+         "scaled Jacobian alone)"},
         {"--threads", "N",
          "threads for the node visits, 1..256 (same output; default: every core)"},
         {"--report", "R.json", "write the JSON report"},

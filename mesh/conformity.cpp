@@ -271,6 +271,7 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   // Quality and volume, per fixed chunk of hexes so the sums do not depend on the thread count.
   struct ChunkSums {
     double scaled_jacobian_sum = 0.0, volume = 0.0, min_scaled_jacobian = 1.0;
+    double max_edge_ratio = 1.0;
     int64_t inverted = 0;
     std::array<int64_t, 20> histogram{};
     std::vector<int32_t> defects;  // ascending, at most the limit per kind
@@ -287,6 +288,7 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
       s.scaled_jacobian_sum += sj;
       s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
       s.volume += volumes[h - begin];
+      s.max_edge_ratio = std::max(s.max_edge_ratio, hex_edge_ratio(hex_points(mesh, h)));
       ++s.histogram[scaled_jacobian_bin(sj)];
       if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
         s.defects.push_back(h);
@@ -298,6 +300,7 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
     sum_scaled_jacobian += s.scaled_jacobian_sum;
     r.volume += s.volume;
     r.min_scaled_jacobian = std::min(r.min_scaled_jacobian, s.min_scaled_jacobian);
+    r.max_edge_ratio = std::max(r.max_edge_ratio, s.max_edge_ratio);
     if (s.inverted > 0 && r.inverted_hexes == 0) r.first_inverted_hex = s.defects.front();
     r.inverted_hexes += s.inverted;
     for (int b = 0; b < 20; ++b) r.scaled_jacobian_histogram[b] += s.histogram[b];
@@ -445,6 +448,7 @@ void to_json(nlohmann::json& j, const MeshCheckReport& r) {
   j["boundary_faces"] = r.boundary_faces;
   j["min_scaled_jacobian"] = r.min_scaled_jacobian;
   j["mean_scaled_jacobian"] = r.mean_scaled_jacobian;
+  j["max_edge_ratio"] = r.max_edge_ratio;
   j["volume"] = r.volume;
   j["boundary_area"] = r.boundary_area;
   j["defect_hexes"] = r.defect_hexes;

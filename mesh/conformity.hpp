@@ -84,6 +84,9 @@ struct MeshCheckReport {
   int64_t boundary_faces = 0;
   /// Over all hexes; 1 for an empty mesh.
   double min_scaled_jacobian = 1.0, mean_scaled_jacobian = 1.0;
+  /// Largest hex_edge_ratio over all hexes (longest over shortest edge; 1 for an empty mesh):
+  /// what the scaled Jacobian does not see, a hex whose angles are fine and one edge collapsed.
+  double max_edge_ratio = 1.0;
   /// Sum of signed hex volumes; sum of boundary-face areas.
   double volume = 0.0, boundary_area = 0.0;
   /// Lowest id of an inverted hex, -1 if none.

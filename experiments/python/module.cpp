@@ -235,7 +235,7 @@ PYBIND11_MODULE(_hexrefine, m) {
       [](const HexMesh& mesh, const py::object& targets, const std::string& method, int passes,
          const std::string& buffer, bool smooth, bool ranking, const std::string& directional_order,
          bool propagation, bool ebe_only, const std::string& placement, int threads,
-         bool allow_inverted, int64_t max_hexes) {
+         bool allow_inverted, int64_t max_hexes, double max_edge_ratio) {
         PipelineOptions o;
         o.method = method;
         if (py::isinstance<py::str>(targets) || py::isinstance<py::list>(targets) ||
@@ -285,6 +285,11 @@ PYBIND11_MODULE(_hexrefine, m) {
         else if (placement != "optimized")
           throw InputError("placement must be 'trilinear' or 'optimized', got '" + placement + "'");
         o.smooth = smooth;
+        if (!(max_edge_ratio == 0 || (max_edge_ratio >= 1 && max_edge_ratio <= 1e6)))
+          throw InputError("max_edge_ratio must be 0 or in 1..1e6, got " +
+                           std::to_string(max_edge_ratio));
+        o.refine.placement.max_edge_ratio = max_edge_ratio;
+        o.smoothing.max_edge_ratio = max_edge_ratio;
         o.max_hexes = max_hexes;
         PipelineResult r;
         {
@@ -296,14 +301,16 @@ PYBIND11_MODULE(_hexrefine, m) {
       "mesh"_a, "targets"_a, "method"_a = "selective", "passes"_a = 1, "buffer"_a = "layer",
       "smooth"_a = false, "ranking"_a = true, "directional_order"_a = "by_hex",
       "propagation"_a = true, "ebe_only"_a = false, "placement"_a = "optimized", "threads"_a = 1,
-      "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647},
+      "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647}, "max_edge_ratio"_a = 20.0,
       "Refines `targets` (hex ids, or selection specs) by `method` through the pipeline: plan, "
       "apply, place the new nodes (placement 'optimized' or the thesis' 'trilinear'), check "
       "against the input, optionally smooth and check again. Returns (mesh, report): the mesh "
       "with template_tag, refinement_level and parent_hex attributes, the report a dict with the "
       "keys of `hexrefine refine --report`. `buffer` (passes > 1): 'layer' (the thesis' rule), "
       "'transitions' or 'none'. `threads`: for the template application, node placement, "
-      "smoothing and the check (the same mesh for any count). RefinementError if the method "
+      "smoothing and the check (the same mesh for any count). `max_edge_ratio`: optimized "
+      "placement and smoothing give no hex an edge ratio above it or its ratio before (0: no "
+      "cap). RefinementError if the method "
       "refuses or the result "
       "is invalid (unless an ablation switch or allow_inverted); ValueError for bad input.");
   m.def(

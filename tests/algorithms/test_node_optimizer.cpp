@@ -36,9 +36,11 @@ TEST(NodeOptimizer, LevelsReplayTheSerialSweepOnAnyThreadCount) {
     o.method = "selective";
     o.select = {c.select};
     o.smooth = true;
-    // The sweeps alone: the references predate the joint ascent.
+    // The sweeps alone, no edge-ratio cap: the references predate both.
     o.refine.placement.joint_iterations = 0;
     o.smoothing.joint_iterations = 0;
+    o.refine.placement.max_edge_ratio = 0;
+    o.smoothing.max_edge_ratio = 0;
     std::optional<HexMesh> first;
     for (int threads : {1, 2}) {
       SCOPED_TRACE(threads);

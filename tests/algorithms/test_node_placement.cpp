@@ -189,12 +189,12 @@ TEST(NodePlacement, LaterPassesMoveTheEarlierPassesNewNodesNeverTheInputs) {
   // centre: pass 2 refines pass 1's transition children (minimum after pass 1: 0.451
   // selective, 0.504 sheet), whose corners include pass-1 nodes. Held fixed there, as when
   // each pass placed only its own new nodes, the minimum was 0.240 (selective) and 0.065
-  // (sheet); moving with pass 2's nodes, as new nodes of the refinement, 0.416 and 0.107.
-  // The input's nodes never move.
+  // (sheet); moving with pass 2's nodes, as new nodes of the refinement, 0.416 and 0.107
+  // (0.082 for sheet under the default edge-ratio cap). The input's nodes never move.
   const HexMesh m = fixture_brick(6, 6, 6);
   const Targets t{select_hexes(m, {"sphere:3,3,3,1.2"}).hexes};
   ASSERT_EQ(t.hexes.size(), 8u);
-  for (const auto& [method, floor] : {std::pair{"selective", 0.41}, std::pair{"sheet", 0.1}}) {
+  for (const auto& [method, floor] : {std::pair{"selective", 0.41}, std::pair{"sheet", 0.08}}) {
     RefineOptions o;
     o.passes = 2;
     o.buffer = PassBuffer::layer;
@@ -205,6 +205,37 @@ TEST(NodePlacement, LaterPassesMoveTheEarlierPassesNewNodesNeverTheInputs) {
     EXPECT_LT(boundary_drift(m, r.mesh), 1e-12) << method;
     for (int32_t n = 0; n < m.point_count(); ++n)
       ASSERT_EQ(r.mesh.points[n], m.points[n]) << method << " input node " << n;
+  }
+}
+
+TEST(NodePlacement, EdgeRatioCapKeepsTheEdgesTheScaledJacobianAloneCollapses) {
+  // The shared sphere's blob:20,2 (2:1 boundary parents): the trilinear children reach an edge
+  // ratio of 8 (selective) and 6 (sheet). Raising the worst scaled Jacobian alone pulls new
+  // nodes onto each other (edge ratios in the thousands); under the cap no hex of the placed or
+  // the smoothed mesh exceeds 20, and the minimum is still well above trilinear's 0.1.
+  const HexMesh m = mesh_read(shared_mesh("sphere_conforming.mesh"));
+  for (const char* method : {"selective", "sheet"}) {
+    SCOPED_TRACE(method);
+    PipelineOptions o;
+    o.method = method;
+    o.select = {"blob:20,2"};
+    o.refine.placement.method = PlacementMethod::trilinear;
+    const PipelineResult trilinear = pipeline_run(m, o);
+    EXPECT_NEAR(trilinear.check.max_edge_ratio, std::string(method) == "sheet" ? 6 : 8, 1e-9);
+    EXPECT_NEAR(trilinear.check.min_scaled_jacobian, 0.1, 1e-9);
+    o.refine.placement.method = PlacementMethod::optimized;
+    o.refine.placement.max_edge_ratio = 0;
+    EXPECT_GT(pipeline_run(m, o).check.max_edge_ratio, 1000);
+    o.refine.placement.max_edge_ratio = 20;
+    o.smooth = true;
+    const PipelineResult capped = pipeline_run(m, o);
+    EXPECT_TRUE(capped.check.valid());
+    EXPECT_LE(capped.check.max_edge_ratio, 20 * (1 + 1e-9));
+    EXPECT_GT(capped.check.min_scaled_jacobian, 0.12);
+    ASSERT_TRUE(capped.smoothed_check);
+    EXPECT_TRUE(capped.smoothed_check->valid());
+    EXPECT_LE(capped.smoothed_check->max_edge_ratio, 20 * (1 + 1e-9));
+    EXPECT_GE(capped.smoothed_check->min_scaled_jacobian, capped.check.min_scaled_jacobian);
   }
 }
 

@@ -149,9 +149,14 @@ TEST(CliRefine, BadUsageAndInvertedInputExitTwo) {
         join({"refine", in, out, "--method octree --select all"}),
         join({"refine", in, out, "--method selective"}),
         join({"refine", in, "--method selective --select all"}),
-        join({"refine", in, out, "--method selective --select all --passes 0"})}) {
+        join({"refine", in, out, "--method selective --select all --passes 0"}),
+        join({"refine", in, out, "--method selective --select all --max-edge-ratio 0.5"}),
+        join({"refine", in, out, "--method selective --select all --max-edge-ratio wide"})}) {
     const CliRun r = cli_run(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
+    if (args.find("--max-edge-ratio") != std::string::npos) {
+      EXPECT_NE(r.output.find("--max-edge-ratio"), std::string::npos) << r.output;
+    }
   }
   EXPECT_FALSE(std::filesystem::exists(out));
   const std::string inverted = shared_mesh("sphere_projected_inverted.mesh");

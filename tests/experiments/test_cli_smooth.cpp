@@ -138,6 +138,8 @@ TEST(CliSmooth, BadUsageExitsTwoAndWritesNothing) {
       {"smooth " + in + " " + out + " --sweeps -1", "--sweeps"},
       {"smooth " + in + " " + out + " --sweeps many", "--sweeps"},
       {"smooth " + in + " " + out + " --joint-iterations -3", "--joint-iterations"},
+      {"smooth " + in + " " + out + " --max-edge-ratio 0.9", "--max-edge-ratio"},
+      {"smooth " + in + " " + out + " --max-edge-ratio -", "--max-edge-ratio"},
       {"smooth " + in + " " + out + " --region box:1,2", "box"},
       {"smooth " + in + " " + out + " --bogus", "--bogus"},
       {"smooth " + in + " " + (dir / "out.stl").string(), "out.stl"},

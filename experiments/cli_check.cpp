@@ -89,7 +89,8 @@ int check_run(const CliArgs& a) {
   out << path << ": " << report.hexes << " hexes, " << report.nodes << " nodes, "
       << report.boundary_faces << " boundary faces\n";
   out << "  scaled Jacobian: min " << format_number(report.min_scaled_jacobian) << ", mean "
-      << format_number(report.mean_scaled_jacobian) << "\n";
+      << format_number(report.mean_scaled_jacobian) << "; largest edge ratio "
+      << format_number(report.max_edge_ratio) << "\n";
   out << "  volume " << format_number(report.volume) << ", boundary area "
       << format_number(report.boundary_area) << "\n";
   if (sheets)

@@ -117,8 +117,9 @@ int refine_run(const CliArgs& a) {
             << final_check.inverted_hexes << " inverted, min scaled Jacobian "
             << r.check.min_scaled_jacobian;
   if (r.smoothing) std::cout << " (smoothed " << final_check.min_scaled_jacobian << ")";
-  std::cout << ", refine " << r.stage_seconds.at("refine") << " s, total "
-            << r.stage_seconds.at("total") << " s\n";
+  std::cout << ", largest edge ratio " << final_check.max_edge_ratio << ", refine "
+            << r.stage_seconds.at("refine") << " s, total " << r.stage_seconds.at("total")
+            << " s\n";
   for (const std::string& d : mesh_check_defects(final_check)) std::cout << "  " << d << "\n";
   return 0;
 }

@@ -63,9 +63,23 @@ TEST(Conformity, BrickIsClean) {
   EXPECT_EQ(r.boundary_faces, 2 * (3 * 2 + 3 * 2 + 2 * 2));
   EXPECT_DOUBLE_EQ(r.min_scaled_jacobian, 1.0);
   EXPECT_DOUBLE_EQ(r.mean_scaled_jacobian, 1.0);
+  EXPECT_DOUBLE_EQ(r.max_edge_ratio, 1.0);
   EXPECT_NEAR(r.volume, 12.0, 1e-12);
   EXPECT_NEAR(r.boundary_area, 32.0, 1e-12);
   EXPECT_FALSE(r.reference_compared);
+}
+
+TEST(Conformity, LargestEdgeRatioSeesACollapsingEdgeTheScaledJacobianDoesNot) {
+  // One unit cube, its corner 6 drawn down onto corner 2 until edge 2-6 is 1e-3 long: the hex
+  // stays positive (scaled Jacobian > 0), and its edge ratio is the edges 5-6 and 6-7 (about
+  // sqrt(2)) over 1e-3.
+  HexMesh m = fixture_brick(1, 1, 1);
+  m.points[m.hexes[0][6]] = m.points[m.hexes[0][2]] + Eigen::Vector3d(0, 0, 1e-3);
+  const MeshCheckReport r = mesh_check(m);
+  EXPECT_GT(r.min_scaled_jacobian, 0);
+  const double longest = (m.points[m.hexes[0][6]] - m.points[m.hexes[0][5]]).norm();
+  EXPECT_NEAR(r.max_edge_ratio, longest / 1e-3, 1e-6);
+  EXPECT_GT(r.max_edge_ratio, 1000);
 }
 
 TEST(Conformity, TwoHexesSharingTwoFacesAreADoublet) {
@@ -436,10 +450,11 @@ TEST(Conformity, JsonCarriesEveryCount) {
   EXPECT_EQ(j["hanging_nodes"], 5);
   EXPECT_EQ(j["conformal"], false);
   EXPECT_EQ(j["valid"], false);
-  for (const char* key : {"nodes", "inverted_hexes", "doublets", "nonmanifold_faces",
-                          "nonmanifold_boundary_edges", "duplicate_nodes", "unused_nodes",
-                          "boundary_faces", "min_scaled_jacobian", "mean_scaled_jacobian", "volume",
-                          "boundary_area", "first_inverted_hex", "reference_compared"})
+  for (const char* key :
+       {"nodes", "inverted_hexes", "doublets", "nonmanifold_faces", "nonmanifold_boundary_edges",
+        "duplicate_nodes", "unused_nodes", "boundary_faces", "min_scaled_jacobian",
+        "mean_scaled_jacobian", "max_edge_ratio", "volume", "boundary_area", "first_inverted_hex",
+        "reference_compared"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 

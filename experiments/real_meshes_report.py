@@ -199,6 +199,18 @@ def main():
                                                           fmt(s["edge_ratio"], 3))
                                           for s in capped if s not in capped_ok) + ")"))
     out.append("| the same after `--smooth` | %d of %d |" % (len(capped_smooth_ok), len(capped)))
+    # Where trilinear placement is not refused: does smoothing end higher from its positions?
+    smoothed_of = {(s["mesh"], s["kind"], s["method"], s["placement"]): s for s in done}
+    pairs = [(s, smoothed_of[(s["mesh"], s["kind"], s["method"], "trilinear")])
+             for s in optimized if (s["mesh"], s["kind"], s["method"], "trilinear") in smoothed_of]
+    out.append("| (observed) `--smooth` from the trilinear positions instead of the optimized ones, "
+               "where trilinear is valid: higher / lower / equal; >= 0.5 x parents' min | "
+               "%d / %d / %d of %d; %d (from optimized: %d) |" % (
+                   sum(t["smoothed"] > o["smoothed"] + 1e-6 for o, t in pairs),
+                   sum(t["smoothed"] < o["smoothed"] - 1e-6 for o, t in pairs),
+                   sum(abs(t["smoothed"] - o["smoothed"]) <= 1e-6 for o, t in pairs), len(pairs),
+                   sum(t["smoothed"] >= 0.5 * t["parents"] - 1e-12 for _, t in pairs),
+                   sum(o["smoothed"] >= 0.5 * o["parents"] - 1e-12 for o, _ in pairs)))
     out.append("| every output written valid (checked against its input) | %d of %d |" % (
         sum(1 for s in done if s["valid"] and s["smoothed_valid"]), len(done)))
 

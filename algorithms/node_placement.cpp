@@ -14,7 +14,8 @@
 ///
 /// Steps of one pass:
 ///  1. Active children: those whose scaled Jacobian is below PlacementOptions::active_ratio
-///     times their parent's, or not positive. Children of a parallelepiped by a template of
+///     times their parent's, or not positive (PlacementMethod::untangle: only those not
+///     positive, and no joint ascent in step 4). Children of a parallelepiped by a template of
 ///     boxes equal their parent and are skipped without evaluating them.
 ///  2. Free nodes: the new nodes of active children. From the template node that made each
 ///     (entity and local index in its parent): strictly inside the parent, or on an interior
@@ -212,7 +213,15 @@ std::optional<NodeSlide> ReferenceSlides::at_input_node(const Eigen::Vector3d& x
 }
 
 std::string_view placement_method_name(PlacementMethod m) {
-  return m == PlacementMethod::trilinear ? "trilinear" : "optimized";
+  switch (m) {
+    case PlacementMethod::trilinear:
+      return "trilinear";
+    case PlacementMethod::optimized:
+      return "optimized";
+    case PlacementMethod::untangle:
+      return "untangle";
+  }
+  return "optimized";
 }
 
 BoundaryReference boundary_reference_build(const HexMesh& input, const HexTopology& t) {
@@ -264,7 +273,9 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
     const int32_t count = static_cast<int32_t>(uses[u].tmpl->children.size());
     for (int32_t c = first; c < first + count; ++c) {
       const double q = hex_scaled_jacobian(hex_points(refined, c));
-      if (q < options.active_ratio * parent || !(q > 0)) {
+      const bool poor =
+          options.method != PlacementMethod::untangle && q < options.active_ratio * parent;
+      if (poor || !(q > 0)) {
         active.push_back(c);
         active_use.push_back(static_cast<int32_t>(u));
         use_active[u] = 1;
@@ -440,7 +451,8 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
   start_points.reserve(problem.nodes.size());
   for (int32_t v : problem.nodes) start_points.push_back(refined.points[v]);
   JointAscentOptions joint_options;
-  joint_options.max_iterations = options.joint_iterations;
+  joint_options.max_iterations =
+      options.method == PlacementMethod::untangle ? 0 : options.joint_iterations;
   joint_options.threads = pass.threads;
   joint_options.max_edge_ratio = options.max_edge_ratio;
   const SweepsAndAscentStats run =

@@ -72,9 +72,12 @@ int refine_run(const CliArgs& a) {
       o.refine.placement.method = PlacementMethod::trilinear;
     else if (*p == "optimized")
       o.refine.placement.method = PlacementMethod::optimized;
+    else if (*p == "untangle")
+      o.refine.placement.method = PlacementMethod::untangle;
     else
-      throw InputError("hexrefine refine: --placement must be trilinear or optimized, got '" + *p +
-                       "'");
+      throw InputError(
+          "hexrefine refine: --placement must be trilinear, optimized or untangle, got '" + *p +
+          "'");
   }
   o.smooth = a.flag("--smooth");
   if (const auto r = a.value("--max-edge-ratio")) {
@@ -145,8 +148,9 @@ const CliCommand cli_refine_command = {
          "H-2), transitions (every transition's children, cumulative) or none"},
         {"--no-buffer", "", "ablation: the same as --buffer none"},
         {"--placement", "P",
-         "new nodes: trilinear (the thesis' positions) or optimized "
-         "(default: raise the worst scaled Jacobian, untangle)"},
+         "new nodes: trilinear (the thesis' positions), optimized (default: raise the worst "
+         "scaled Jacobian, untangle) or untangle (trilinear, inverted children untangled: the "
+         "better start for --smooth)"},
         {"--smooth", "", "smooth the refined region afterwards (checked again)"},
         {"--max-edge-ratio", "R",
          "optimized placement and --smooth give no hex an edge ratio above R or its ratio before "

@@ -178,8 +178,10 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
         c.options.placement.method = PlacementMethod::trilinear;
       else if (placement == "optimized")
         c.options.placement.method = PlacementMethod::optimized;
+      else if (placement == "untangle")
+        c.options.placement.method = PlacementMethod::untangle;
       else
-        op.at("placement").fail("expected \"trilinear\" or \"optimized\"");
+        op.at("placement").fail("expected \"trilinear\", \"optimized\" or \"untangle\"");
     }
   }
   if (j.contains("tags")) {

@@ -253,19 +253,20 @@ class JointProblem {
       double m = std::numeric_limits<double>::infinity();
       for (int64_t h = b; h < e; h += 2) {
         const int64_t g = std::min(h + 1, e - 1);  // an odd chunk end evaluates its last twice
-        hex_scaled_jacobian_samples_pair(hex_points(mesh_, hexes_[h]), hex_points(mesh_, hexes_[g]),
-                                         samples_[h], samples_[g]);
+        const Corners ph = hex_points(mesh_, hexes_[h]), pg = hex_points(mesh_, hexes_[g]);
+        hex_scaled_jacobian_samples_pair(ph, pg, samples_[h], samples_[g]);
+        // Past its edge-ratio cap a hex makes the point infeasible, like a non-finite sample.
+        constexpr double none = std::numeric_limits<double>::infinity();
+        if ((edge_caps_[h] != none && !(hex_edge_ratio(ph) <= edge_caps_[h])) ||
+            (edge_caps_[g] != none && !(hex_edge_ratio(pg) <= edge_caps_[g])))
+          m = -std::numeric_limits<double>::infinity();
       }
-      for (int64_t h = b; h < e; ++h) {
+      for (int64_t h = b; h < e; ++h)
         for (int k = 0; k < 9; ++k) {
           if (!(masks_[h] >> k & 1)) continue;
           const double s = samples_[h][k];
           m = std::isfinite(s) ? std::min(m, s) : -std::numeric_limits<double>::infinity();
         }
-        // Past its edge-ratio cap a hex makes the point infeasible, like a non-finite sample.
-        if (!(hex_edge_ratio(hex_points(mesh_, hexes_[h])) <= edge_caps_[h]))
-          m = -std::numeric_limits<double>::infinity();
-      }
       chunk_min_[c] = m;
     });
     min = std::numeric_limits<double>::infinity();

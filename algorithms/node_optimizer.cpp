@@ -280,17 +280,20 @@ class Optimizer {
     size_t t = 0;
     const int32_t first = problem_.node_hex_offsets[i], end = problem_.node_hex_offsets[i + 1];
     std::array<double, 2> pair{};
+    std::array<HexCorners, 2> corners;
     for (int32_t k = first; k < end; ++k) {
       const int32_t local_hex = problem_.node_hex[k];
+      const int lane = (k - first) % 2;
       // Two hexes per evaluation (the kernel's two lanes); an early stop wastes at most one.
-      if ((k - first) % 2 == 0)
-        pair = hex_scaled_jacobian_pair(
-            hex_points(mesh_, problem_.hexes[local_hex]),
-            hex_points(mesh_, problem_.hexes[problem_.node_hex[std::min(k + 1, end - 1)]]));
-      const double q = pair[(k - first) % 2];
+      if (lane == 0) {
+        corners[0] = hex_points(mesh_, problem_.hexes[local_hex]);
+        corners[1] = hex_points(mesh_, problem_.hexes[problem_.node_hex[std::min(k + 1, end - 1)]]);
+        pair = hex_scaled_jacobian_pair(corners[0], corners[1]);
+      }
+      const double q = pair[lane];
       // A hex stretched past its edge-ratio cap counts as inverted: not allowed.
-      if (!(hex_edge_ratio(hex_points(mesh_, problem_.hexes[local_hex])) <=
-            shared_.edge_cap[local_hex]))
+      const double cap = shared_.edge_cap[local_hex];
+      if (cap != std::numeric_limits<double>::infinity() && !(hex_edge_ratio(corners[lane]) <= cap))
         allowed = false;
       trial_[t++] = q;
       local_min = std::min(local_min, q);

@@ -63,7 +63,9 @@ def study_cases(path, max_output_hexes):
     return cases
 
 
-def main():
+def study_cases_with_meshes():
+    """The command line (--out, --records, --max-output-hexes), the study's cases, and each case
+    with its input mesh (read once per file): what this script and smooth_start.py share."""
     parser = argparse.ArgumentParser()
     parser.add_argument("--out", default="results")
     parser.add_argument("--records", default=str(ROOT / "results" / "real_meshes.jsonl"))
@@ -73,11 +75,18 @@ def main():
     if not cases:
         fail("%s: no optimized real-mesh cases to run" % args.records)
     meshes = {}
-    records = []
+    pairs = []
     for case in cases:
         if case["file"] not in meshes:
             meshes[case["file"]] = hexrefine.read(case["file"])
-        mesh = meshes[case["file"]]
+        pairs.append((case, meshes[case["file"]]))
+    return args, cases, pairs
+
+
+def main():
+    args, cases, pairs = study_cases_with_meshes()
+    records = []
+    for case, mesh in pairs:
         for cap in CAPS:
             _, report = hexrefine.refine(mesh, case["specs"], method=case["method"],
                                          passes=case["passes"], buffer=case["buffer"],

@@ -10,36 +10,25 @@ minutes on one core.
     PYTHONPATH=build/experiments/python /usr/bin/python3 experiments/smooth_start.py --out results
 """
 
-import argparse
 import json
 import math
 import os
 import pathlib
 
 import hexrefine
-from edge_ratio_cap import ROOT, fail, fmt, study_cases
+from edge_ratio_cap import fmt, study_cases_with_meshes
 
 PLACEMENTS = ["optimized", "untangle", "trilinear"]
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--out", default="results")
-    parser.add_argument("--records", default=str(ROOT / "results" / "real_meshes.jsonl"))
-    parser.add_argument("--max-output-hexes", type=int, default=60000)
-    args = parser.parse_args()
-    cases = study_cases(pathlib.Path(args.records), args.max_output_hexes)
-    if not cases:
-        fail("%s: no optimized real-mesh cases to run" % args.records)
-    meshes = {}
+    args, cases, pairs = study_cases_with_meshes()
     records = []
-    for case in cases:
-        if case["file"] not in meshes:
-            meshes[case["file"]] = hexrefine.read(case["file"])
+    for case, mesh in pairs:
         for placement in PLACEMENTS:
             record = dict(case, placement=placement)
             try:
-                _, report = hexrefine.refine(meshes[case["file"]], case["specs"],
+                _, report = hexrefine.refine(mesh, case["specs"],
                                              method=case["method"], passes=case["passes"],
                                              buffer=case["buffer"], smooth=True,
                                              placement=placement)

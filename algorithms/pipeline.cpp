@@ -100,18 +100,13 @@ class OutputWriteError : public InputError {
   using InputError::InputError;
 };
 
-/// Throws when `check` (of `mesh`, refined from `input`) is invalid and no switch allows it.
-void verdict_enforce(const MeshCheckReport& check, const HexMesh& mesh, const HexMesh& input,
-                     const PipelineOptions& o, bool ablation, const std::string& what) {
-  if (check.valid() || ablation || o.refine.allow_inverted) return;
-  // An input that already fails the checker (e.g. a voxel mesh whose cubes touch along edges)
-  // is bad input, not a refiner failure.
-  const MeshCheckReport input_check = mesh_check(input);
-  if (!input_check.valid()) {
-    std::string why;
-    for (const std::string& d : mesh_check_defects(input_check)) why += "\n  " + d;
-    throw InputError("the input mesh is not valid, so no refinement of it can be:" + why);
-  }
+/// Whether a result with this check may be returned: valid, or a switch allows it.
+bool verdict_allows(const MeshCheckReport& check, const PipelineOptions& o, bool ablation) {
+  return check.valid() || ablation || o.refine.allow_inverted;
+}
+
+/// The defects of `check` (of `mesh`) as lines, and the input hexes they descend from.
+std::string defects_text(const MeshCheckReport& check, const HexMesh& mesh) {
   std::string why;
   for (const std::string& d : mesh_check_defects(check)) why += "\n  " + d;
   if (const std::vector<int32_t>* parent = mesh_find_attribute(mesh, attribute_parent_hex)) {
@@ -119,14 +114,37 @@ void verdict_enforce(const MeshCheckReport& check, const HexMesh& mesh, const He
     for (int32_t h : check.defect_hexes) parents.push_back((*parent)[h]);
     std::sort(parents.begin(), parents.end());
     parents.erase(std::unique(parents.begin(), parents.end()), parents.end());
-    why += "\n  refined from input hexes";
+    if (!parents.empty()) why += "\n  refined from input hexes";
     for (int32_t p : parents) {
       why += ' ';
       why += std::to_string(p);
     }
   }
-  throw OperationError(what + " left an invalid mesh; nothing written:" + why);
+  return why;
 }
+
+/// Throws when the refined mesh's `check` is invalid and no switch allows it, naming the stage
+/// that failed: InputError when the input itself fails the checker (nothing refined from it can
+/// be valid), OperationError naming the refiner and the defects otherwise.
+void refine_verdict_enforce(const MeshCheckReport& check, const HexMesh& mesh, const HexMesh& input,
+                            const PipelineOptions& o, bool ablation) {
+  if (verdict_allows(check, o, ablation)) return;
+  const MeshCheckReport input_check = mesh_check(input, nullptr, o.refine.threads);
+  if (!input_check.valid()) {
+    std::string why;
+    for (const std::string& d : mesh_check_defects(input_check)) why += "\n  " + d;
+    throw InputError(
+        "the input mesh fails the check (before any refinement), so no refinement "
+        "of it can be valid:" +
+        why);
+  }
+  throw OperationError("the " + o.method + " refiner left an invalid mesh; nothing written:" +
+                       defects_text(check, mesh));
+}
+
+/// At most this many rounds of undoing the smoothing around the defects the checker finds,
+/// before the whole smoothing is undone.
+constexpr int smoothing_undo_rounds = 4;
 
 }  // namespace
 
@@ -231,10 +249,10 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
   if (o.smooth) smooth_region = mesh_refined_hexes(r.mesh);
   // Checks the mesh; the check of the final mesh runs beside its write to `out` when there is
   // more than one thread (the writer takes a thread of its own; one thread: one after the
-  // other). The written file becomes `out` only once the verdict allows it.
+  // other). The written file becomes `out` only once the verdict allows it: returns false, with
+  // nothing written, when it does not.
   auto mesh_check_and_write = [&](const std::string& stage, MeshCheckReport& check,
-                                  double& children_min_scaled_jacobian, bool final_mesh,
-                                  const std::string& what) {
+                                  double& children_min_scaled_jacobian, bool final_mesh) {
     std::optional<StagedMeshWrite> staged;
     if (final_mesh && !out.empty() && o.refine.threads > 1) {
       clock.begin(stage == "check" ? "check and write" : "check (smoothed) and write");
@@ -245,7 +263,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     const double writer_cpu = staged ? staged->cpu_seconds_so_far() : 0.0;
     clock.end(stage);
     r.stage_cpu_seconds[stage] -= writer_cpu;  // the writer's thread is the write stage's
-    verdict_enforce(check, r.mesh, input, o, r.ablation, what);
+    if (!verdict_allows(check, o, r.ablation)) return false;
     if (final_mesh && !out.empty()) {
       if (!staged) {
         clock.begin("write");
@@ -262,10 +280,12 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
         *o.verbose << "hexrefine: write " << std::fixed << std::setprecision(3) << staged->seconds()
                    << " s" << (o.refine.threads > 1 ? " (beside the check)" : "") << std::endl;
     }
+    return true;
   };
 
-  mesh_check_and_write("check", r.check, r.children_min_scaled_jacobian, smooth_region.empty(),
-                       "the " + o.method + " refiner");
+  if (!mesh_check_and_write("check", r.check, r.children_min_scaled_jacobian,
+                            smooth_region.empty()))
+    refine_verdict_enforce(r.check, r.mesh, input, o, r.ablation);
   if (!smooth_region.empty()) {
     SmoothOptions so = o.smoothing;
     so.region_hexes = std::move(smooth_region);
@@ -276,14 +296,75 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     so.reference = &reference;
     so.reference_nodes = input.point_count();
     so.threads = o.refine.threads;
+    const std::vector<Eigen::Vector3d> unsmoothed = r.mesh.points;
     clock.begin("smooth");
     r.smoothing = mesh_smooth(r.mesh, so);
     clock.end("smooth");
     clock.begin("check (smoothed)");
     r.smoothed_check.emplace();
     r.smoothed_children_min_scaled_jacobian.emplace();
-    mesh_check_and_write("check_smoothed", *r.smoothed_check,
-                         *r.smoothed_children_min_scaled_jacobian, true, "smoothing");
+    // Smoothing never fails a valid refinement: where the checker rejects the smoothed mesh
+    // (a boundary face its nodes slid across a strongly curved input patch, say), the nodes of
+    // the defect hexes and of the hexes around them go back to their unsmoothed positions,
+    // round by round; after smoothing_undo_rounds rounds all of them do. The refined mesh
+    // passed the same check, so the last resort is valid.
+    for (int round = 0;; ++round) {
+      const bool whole = round == smoothing_undo_rounds;
+      if (mesh_check_and_write("check_smoothed", *r.smoothed_check,
+                               *r.smoothed_children_min_scaled_jacobian, true))
+        break;
+      if (whole) {
+        // Unreachable for a valid refined mesh; kept so that a checker disagreeing with itself
+        // names the stage instead of looping.
+        throw OperationError("smoothing was undone and the mesh still fails the check:" +
+                             defects_text(*r.smoothed_check, r.mesh));
+      }
+      std::string why;
+      for (const std::string& d : mesh_check_defects(*r.smoothed_check))
+        why += (why.empty() ? "" : "; ") + d;
+      if (round == 0) r.smoothing_warning = "the smoothed mesh failed the check (" + why + ")";
+      int64_t undone = 0;
+      auto undo = [&](int32_t h) {
+        for (int32_t v : r.mesh.hexes[h])
+          if (r.mesh.points[v] != unsmoothed[v]) {
+            r.mesh.points[v] = unsmoothed[v];
+            ++undone;
+          }
+      };
+      if (round + 1 == smoothing_undo_rounds) {
+        for (int32_t h = 0; h < r.mesh.hex_count(); ++h) undo(h);
+        r.smoothing_warning += "; the whole smoothing was undone";
+      } else {
+        // The listed defect hexes (the checker names the lowest ids) and a ring around them.
+        std::vector<uint8_t> near(r.mesh.points.size(), 0);
+        for (int32_t h : r.smoothed_check->defect_hexes)
+          for (int32_t v : r.mesh.hexes[h]) near[v] = 1;
+        for (int32_t h = 0; h < r.mesh.hex_count(); ++h)
+          if (std::any_of(r.mesh.hexes[h].begin(), r.mesh.hexes[h].end(),
+                          [&](int32_t v) { return near[v]; }))
+            undo(h);
+        // A hex with some corners back and some smoothed can be worse than both meshes: undo
+        // those too, until every hex is at least the unsmoothed minimum (the unsmoothed mesh
+        // is, so this ends).
+        for (bool again = true; again;) {
+          again = false;
+          const std::vector<double> q = mesh_scaled_jacobians(r.mesh);
+          for (int32_t h = 0; h < r.mesh.hex_count(); ++h)
+            if (q[h] < r.check.min_scaled_jacobian) {
+              const int64_t before = undone;
+              undo(h);
+              again = again || undone > before;
+            }
+        }
+      }
+      r.smoothing_nodes_undone += undone;
+    }
+    if (r.smoothing_nodes_undone > 0) {
+      r.smoothing_warning += "; " + std::to_string(r.smoothing_nodes_undone) +
+                             " smoothed nodes went back to their unsmoothed positions";
+      r.smoothing->min_scaled_jacobian_after = r.smoothed_check->min_scaled_jacobian;
+      r.smoothing->mean_scaled_jacobian_after = r.smoothed_check->mean_scaled_jacobian;
+    }
   }
   r.stage_seconds["total"] = seconds_since(start);
   r.peak_memory_mb = process_peak_memory_mb();
@@ -339,7 +420,12 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
     j["refined_parents"]["smoothed_children_min_scaled_jacobian"] =
         *r.smoothed_children_min_scaled_jacobian;
   j["check"] = r.check;
-  if (r.smoothing) j["smoothing"] = {{"stats", *r.smoothing}, {"check", *r.smoothed_check}};
+  if (r.smoothing) {
+    j["smoothing"] = {{"stats", *r.smoothing},
+                      {"check", *r.smoothed_check},
+                      {"nodes_undone", r.smoothing_nodes_undone}};
+    if (!r.smoothing_warning.empty()) j["smoothing"]["warning"] = r.smoothing_warning;
+  }
   j["stage_seconds"] = r.stage_seconds;
   j["stage_cpu_seconds"] = r.stage_cpu_seconds;
   j["peak_memory_mb"] = r.peak_memory_mb;

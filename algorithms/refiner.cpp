@@ -6,6 +6,7 @@
 
 #include "algorithms/selective.hpp"
 #include "algorithms/sheet.hpp"
+#include "algorithms/smoothing.hpp"
 #include "mesh/error.hpp"
 #include "mesh/quality.hpp"
 
@@ -14,6 +15,10 @@ namespace hexrefine {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// Node placement plans a pass again at most this many times, each with the parents whose
+/// children it could not make valid added to the targets (refine, below).
+constexpr int placement_retries = 3;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -57,6 +62,56 @@ void input_validate(const HexMesh& mesh, std::string_view method) {
                      "refinement of them can be valid: hex (scaled Jacobian) " +
                      list + (inverted > 10 ? ", ..." : "") +
                      " (allow_inverted, --allow-inverted, refines them anyway)");
+}
+
+/// The last resort of node placement (issue 28: no refusal of a valid input). Placement moves
+/// only new nodes; where even the retargets leave children inverted (a transition template in a
+/// parent whose own corners hold a child folded), the nodes around those children move too,
+/// the parents' input nodes included, as smoothing moves them (algorithms/smoothing.hpp:
+/// interior nodes freely, boundary nodes sliding on the input's boundary surface, the mesh's
+/// minimum never lowered, no valid hex inverted, the edge-ratio cap kept): the inverted
+/// children and two layers of hexes around them are the region. Returns empty on success and
+/// counts the children it made valid; throws OperationError naming the input hexes when some
+/// stay inverted: the refinement has no valid placement the tool can find, which says nothing
+/// against the input.
+std::vector<int32_t> placement_fallback_untangle(HexMesh& refined,
+                                                 const BoundaryReference& reference,
+                                                 int32_t input_nodes, const RefineOptions& options,
+                                                 RefineStats& stats) {
+  std::vector<int32_t> inverted;
+  const std::vector<double> before = mesh_scaled_jacobians(refined);
+  for (int32_t h = 0; h < refined.hex_count(); ++h)
+    if (!(before[h] > 0)) inverted.push_back(h);
+  SmoothOptions smoothing;
+  smoothing.region_hexes = inverted;
+  smoothing.layers = 2;
+  smoothing.reference = &reference;
+  smoothing.reference_nodes = input_nodes;
+  smoothing.threads = options.threads;
+  smoothing.max_edge_ratio = options.placement.max_edge_ratio;
+  mesh_smooth(refined, smoothing);
+  const std::vector<double> after = mesh_scaled_jacobians(refined);
+  const std::vector<int32_t>* original = mesh_find_attribute(refined, attribute_parent_hex);
+  std::vector<int32_t> stuck;  // input hexes whose children stay inverted
+  for (int32_t h : inverted) {
+    if (after[h] > 0)
+      ++stats.placement_fallback_untangled;
+    else
+      stuck.push_back(original ? (*original)[h] : h);
+  }
+  if (stuck.empty()) return {};
+  std::sort(stuck.begin(), stuck.end());
+  stuck.erase(std::unique(stuck.begin(), stuck.end()), stuck.end());
+  std::string list;
+  for (size_t i = 0; i < stuck.size() && i < 10; ++i)
+    list += (i ? ", " : "") + std::to_string(stuck[i]);
+  throw OperationError(
+      "node placement: " + std::to_string(stuck.size()) +
+      " refined input hexes keep an inverted child after placement, " +
+      std::to_string(placement_retries) +
+      " retargets and the untangling of the nodes around them (input hexes " + list +
+      (stuck.size() > 10 ? ", ..." : "") +
+      "); the input passed the checker: this is a limit of the placement, not of the input");
 }
 
 }  // namespace
@@ -171,7 +226,6 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
     // a template of boxes, its children are images of boxes under its own map, and the
     // transition moves to its neighbours. At most placement_retries new plans; the counts of a
     // dropped plan are undone, its time is kept.
-    constexpr int placement_retries = 3;
     const RefineStats stats_before_plan = stats;
     RefinementPlan plan;
     PlanApplyResult applied;
@@ -196,10 +250,13 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
             original ? std::span<const int32_t>(*original) : std::span<const int32_t>(),
             reference,
             options.allow_inverted,
-            attempt == placement_retries,
+            false,
             options.threads,
             mesh.point_count()};
         failed = place_new_nodes(placement, applied.mesh, options.placement, stats.placement);
+        if (!failed.empty() && attempt == placement_retries)
+          failed = placement_fallback_untangle(applied.mesh, reference, mesh.point_count(), options,
+                                               stats);
       }
       stats.phase_seconds["placement"] += seconds_since(t);
       if (failed.empty()) break;

@@ -110,6 +110,10 @@ struct RefineStats {
   /// Hexes made targets of their pass because node placement found no valid position for the
   /// children a transition template gave them (refiner.cpp); each such pass was planned again.
   int64_t placement_retargets = 0;
+  /// Children still inverted after placement and its retargets that the fallback made valid by
+  /// moving the nodes around them, the refined parents' own (input) nodes included, as
+  /// smoothing does (refiner.cpp); 0 when placement alone sufficed.
+  int64_t placement_fallback_untangled = 0;
   PlacementStats placement;
   /// Seconds per phase: the method's own (marking, element_by_element, ranking, ...) and the
   /// driver's (plan, apply, placement, total).
@@ -120,8 +124,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(
     RefineStats, method, initial_hexes, final_hexes, final_nodes, hexes_per_template, hexes_created,
     hexes_deleted, directional_hexes, directional_groups, ranks, doublets_resolved,
     doublets_by_rule, edges_split_by_propagation, sheet_passes, added_targets,
-    self_intersection_cases, input_edges_forced, placement_retargets, placement, phase_seconds,
-    time_seconds)
+    self_intersection_cases, input_edges_forced, placement_retargets, placement_fallback_untangled,
+    placement, phase_seconds, time_seconds)
 
 /// Fills stats.hexes_per_template from a list of per-hex template tags.
 void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags);

@@ -80,6 +80,7 @@ int refine_run(const CliArgs& a) {
           "'");
   }
   o.smooth = a.flag("--smooth");
+  if (!a.value("--placement")) o.refine.placement.method = pipeline_default_placement(o.smooth);
   if (const auto r = a.value("--max-edge-ratio")) {
     const double cap = cli_parse_double(*r, "hexrefine refine: --max-edge-ratio");
     if (!(cap == 0 || (cap >= 1 && cap <= 1e6)))
@@ -107,6 +108,8 @@ int refine_run(const CliArgs& a) {
   if (!r.selection_warning.empty())
     std::cerr << "hexrefine refine: warning: " << r.selection_warning
               << "; the mesh was written unchanged\n";
+  if (!r.smoothing_warning.empty())
+    std::cerr << "hexrefine refine: warning: " << r.smoothing_warning << "\n";
   if (report_path) {
     nlohmann::json report = pipeline_report(r, o);
     report["input"] = in;
@@ -148,10 +151,13 @@ const CliCommand cli_refine_command = {
          "H-2), transitions (every transition's children, cumulative) or none"},
         {"--no-buffer", "", "ablation: the same as --buffer none"},
         {"--placement", "P",
-         "new nodes: trilinear (the thesis' positions), optimized (default: raise the worst "
-         "scaled Jacobian, untangle) or untangle (trilinear, inverted children untangled: the "
-         "better start for --smooth)"},
-        {"--smooth", "", "smooth the refined region afterwards (checked again)"},
+         "new nodes: trilinear (the thesis' positions), optimized (the default without --smooth: "
+         "raise the worst scaled Jacobian, untangle) or untangle (trilinear, inverted children "
+         "untangled: the default with --smooth, the better start for it)"},
+        {"--smooth", "",
+         "smooth the refined region afterwards (checked again; starts from --placement untangle "
+         "unless a placement is given; a smoothing the checker rejects is undone, with a warning "
+         "in the report)"},
         {"--max-edge-ratio", "R",
          "optimized placement and --smooth give no hex an edge ratio above R or its ratio before "
          "(default 20; 0: no cap, the scaled Jacobian alone)"},

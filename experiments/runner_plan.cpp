@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "algorithms/pipeline.hpp"
 #include "experiments/runner.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"
@@ -184,6 +185,8 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
         op.at("placement").fail("expected \"trilinear\", \"optimized\" or \"untangle\"");
     }
   }
+  if (!j.contains("options") || !j["options"].contains("placement"))
+    c.options.placement.method = pipeline_default_placement(c.smooth);
   if (j.contains("tags")) {
     schema_require_object(j["tags"], p.at("tags"));
     c.tags = j["tags"];

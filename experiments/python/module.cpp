@@ -280,7 +280,9 @@ PYBIND11_MODULE(_hexrefine, m) {
         o.refine.ebe_only = ebe_only;
         o.refine.threads = threads;
         o.refine.allow_inverted = allow_inverted;
-        if (placement == "trilinear")
+        if (placement.empty())
+          o.refine.placement.method = pipeline_default_placement(smooth);
+        else if (placement == "trilinear")
           o.refine.placement.method = PlacementMethod::trilinear;
         else if (placement == "untangle")
           o.refine.placement.method = PlacementMethod::untangle;
@@ -303,11 +305,12 @@ PYBIND11_MODULE(_hexrefine, m) {
       },
       "mesh"_a, "targets"_a, "method"_a = "selective", "passes"_a = 1, "buffer"_a = "layer",
       "smooth"_a = false, "ranking"_a = true, "directional_order"_a = "by_hex",
-      "propagation"_a = true, "ebe_only"_a = false, "placement"_a = "optimized", "threads"_a = 1,
+      "propagation"_a = true, "ebe_only"_a = false, "placement"_a = "", "threads"_a = 1,
       "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647}, "max_edge_ratio"_a = 20.0,
       "Refines `targets` (hex ids, or selection specs) by `method` through the pipeline: plan, "
       "apply, place the new nodes (placement 'optimized', the thesis' 'trilinear', or 'untangle': "
-      "trilinear with inverted children untangled, the better start for smooth=True), check "
+      "trilinear with inverted children untangled, the better start for smooth=True; none given: "
+      "'untangle' with smooth=True, else 'optimized'), check "
       "against the input, optionally smooth and check again. Returns (mesh, report): the mesh "
       "with template_tag, refinement_level and parent_hex attributes, the report a dict with the "
       "keys of `hexrefine refine --report`. `buffer` (passes > 1): 'layer' (the thesis' rule), "

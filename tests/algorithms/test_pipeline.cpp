@@ -91,5 +91,28 @@ TEST(Pipeline, FullRefinementChildrenMinimumIsTheMeshMinimum) {
   EXPECT_GT(r.children_min_scaled_jacobian, 0.0);
 }
 
+// Issue 28: smoothing never fails a valid refinement. On ecr_hanger.mesh the smoothing slides
+// the input's boundary nodes across its most warped boundary quads (warp / diagonal 0.05) and
+// the checker rejects a face there; the nodes around it go back to their unsmoothed positions,
+// the mesh is returned valid, never below the unsmoothed minimum, with a warning and a count.
+TEST(Pipeline, SmoothingTheCheckerRejectsIsUndoneNotAnError) {
+  const HexMesh input = mesh_read(shared_mesh("ecr_hanger.mesh"));
+  PipelineOptions o;
+  o.select = {"random:0.02,1"};
+  o.smooth = true;
+  o.refine.placement.method = pipeline_default_placement(o.smooth);
+  const PipelineResult r = pipeline_run(input, o);
+  ASSERT_TRUE(r.smoothed_check);
+  EXPECT_TRUE(r.check.valid());
+  EXPECT_TRUE(r.smoothed_check->valid());
+  EXPECT_GE(r.smoothed_check->min_scaled_jacobian, r.check.min_scaled_jacobian);
+  EXPECT_GT(r.smoothing_nodes_undone, 0);
+  EXPECT_NE(r.smoothing_warning.find("failed the check"), std::string::npos) << r.smoothing_warning;
+  const nlohmann::json j = pipeline_report(r, o);
+  EXPECT_EQ(j.at("smoothing").at("nodes_undone"), r.smoothing_nodes_undone);
+  EXPECT_EQ(j.at("smoothing").at("warning"), r.smoothing_warning);
+  EXPECT_EQ(j.at("options").at("placement").at("method"), "untangle");
+}
+
 }  // namespace
 }  // namespace hexrefine

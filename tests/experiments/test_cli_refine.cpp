@@ -176,7 +176,9 @@ TEST(CliRefine, InvalidInputIsReportedAsBadInput) {
   const CliRun r = cli_run(join({"refine", shared_mesh("bunny_voxel.mesh"), out,
                                  "--method selective --select sphere:0,0,0,1"}));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("input mesh is not valid"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the input mesh fails the check (before any refinement)"),
+            std::string::npos)
+      << r.output;
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
@@ -214,6 +216,33 @@ TEST(CliRefine, DistortedParentsAreUntangledNotRefused) {
   EXPECT_EQ(optimized.exit_code, 0) << optimized.output;
   EXPECT_NE(optimized.output.find(", conformal, 0 inverted"), std::string::npos)
       << optimized.output;
+}
+
+// Issue 28, decision 2: without --placement, --smooth starts from untangle and a plain refine
+// from optimized; a placement given is kept either way, and the report names the one used.
+TEST(CliRefine, SmoothWithoutPlacementStartsFromUntangle) {
+  const auto dir = test_temp_dir("cli_refine_default_placement");
+  const std::string in = (dir / "b.mesh").string(), out = (dir / "o.mesh").string();
+  mesh_write(in, fixture_brick(4, 4, 4));
+  const std::string report = (dir / "r.json").string();
+  const std::string base = "--method selective --select sphere:2,2,2,0.9 --report " + report;
+  struct Case {
+    std::string flags, placement;
+  };
+  for (const Case& c : {Case{"", "optimized"}, Case{"--smooth", "untangle"},
+                        Case{"--smooth --placement optimized", "optimized"},
+                        Case{"--placement untangle", "untangle"}}) {
+    SCOPED_TRACE(c.flags);
+    const CliRun r = cli_run(join({"refine", in, out, base, c.flags}));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json j = read_json(report);
+    EXPECT_EQ(j.at("options").at("placement").at("method"), c.placement);
+    EXPECT_EQ(j.contains("smoothing"), c.flags.find("--smooth") != std::string::npos);
+    if (j.contains("smoothing")) {
+      EXPECT_EQ(j.at("smoothing").at("nodes_undone"), 0);
+      EXPECT_FALSE(j.at("smoothing").contains("warning"));
+    }
+  }
 }
 
 }  // namespace

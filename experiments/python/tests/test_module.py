@@ -140,8 +140,10 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
     if not path.exists():
         pytest.skip("shared meshes not present")
     mesh = hexrefine.read(str(path))
-    one, report_one = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, threads=1)
-    two, report_two = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, threads=2)
+    one, report_one = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, threads=1,
+                                       placement="optimized")
+    two, report_two = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, threads=2,
+                                       placement="optimized")
     np.testing.assert_array_equal(one.points, two.points)  # bit for bit
     # The serial values (results/real_meshes.jsonl, rockerarm issue-sphere, selective; smoothed:
     # sweeps, joint ascent, sweeps), no hex stretched past the default edge-ratio cap of 20.
@@ -155,6 +157,12 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
     assert uncapped["check"]["max_edge_ratio"] > 4000
     with pytest.raises(ValueError, match="max_edge_ratio"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", max_edge_ratio=0.5)
+    # smooth=True without a placement starts from untangle (issue 28, decision 2): the trilinear
+    # positions with the inverted children untangled, then smoothing, higher than from optimized.
+    _, report = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True)
+    assert report["options"]["placement"]["method"] == "untangle"
+    assert report["smoothing"]["check"]["min_scaled_jacobian"] == 0.45871972484485035
+    assert report["smoothing"]["nodes_undone"] == 0 and "warning" not in report["smoothing"]
 
 
 # --- errors --------------------------------------------------------------------------------------

@@ -40,6 +40,19 @@ TEST(IoMedit, ReadsSharedMeshesWithReadmeHexCounts) {
   EXPECT_EQ(sphere.point_count(), 216);
 }
 
+TEST(IoMedit, SkipsTheShortQuadsSpellingOfTheSurfaceSection) {
+  const auto dir = test_temp_dir("io_medit_quads");
+  const auto p = dir / "quads.mesh";
+  io_write_text(p,
+                "MeshVersionFormatted 1\nDimension 3\nVertices\n8\n0 0 0 0\n1 0 0 0\n1 1 0 0\n"
+                "0 1 0 0\n0 0 1 0\n1 0 1 0\n1 1 1 0\n0 1 1 0\nQuads\n1\n1 2 3 4 7\n"
+                "Hexahedra\n1\n1 2 3 4 5 6 7 8 3\nEnd\n");
+  const HexMesh m = mesh_read(p.string());
+  EXPECT_EQ(m.hex_count(), 1);
+  EXPECT_EQ(m.point_count(), 8);
+  EXPECT_EQ((*mesh_find_attribute(m, attribute_block_id))[0], 3);
+}
+
 TEST(IoMedit, RefusesTetrahedraNamingThem) {
   const auto dir = test_temp_dir("io_medit_tets");
   const auto p = dir / "tet.mesh";

@@ -170,7 +170,7 @@ TEST(RealMeshesReport, CountsTheTargetsOfIssue28PerArm) {
            "| >= 10 meshes | 3 meshes (2 valid inputs), 1 from outside ../shared | **no** |",
            "| unsmoothed default output min >= 0.3 x parents' min | 2 of 2 | retired (issue 28 "
            "decision 3): reported only |",
-           "*default-smooth*: untangle (2 runs)",
+           "*default-smooth*: untangle (3 runs)",
            "| a.mesh | blob-1 | sheet | default (optimized) | node placement: no placement of the "
            "new nodes / hex 7 |",
            "| c.mesh | /corpus | 6,000 | 0.8 | yes | 3 | 0 (0) | 0.125 | 0.125 | 7 |",

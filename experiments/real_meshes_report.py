@@ -132,8 +132,15 @@ def left_out_of(records_path):
     except (OSError, ValueError):
         return ""
     marker = "Left out: "
-    return description[description.index(marker) + len(marker):] \
-        if marker in description else ""
+    if marker not in description:
+        return ""
+    # "PATH: REASON; ..." -> "FILE (REASON)": the folders are in the per-mesh table.
+    entries = []
+    for entry in description[description.index(marker) + len(marker):].split("; "):
+        path, _, reason = entry.partition(": ")
+        entries.append("%s (%s)" % (os.path.basename(path),
+                                    reason.replace(", above the limit of", " >")))
+    return "; ".join(entries)
 
 
 def targets_section(rows):
@@ -178,14 +185,14 @@ def targets_section(rows):
     issue = [s for s in returned if s["kind"] == "issue-sphere"]
     row("rockerarm `sphere:0,0,0,5` smoothed >= 0.5",
         ", ".join("%s %s" % (s["method"], fmt(s["smoothed"], 4)) for s in issue) or "–",
-        bool(issue) and all(s["smoothed"] >= 0.5 - EPS for s in issue))
+        all(s["smoothed"] >= 0.5 - EPS for s in issue) if issue else "not in this run")
     sized = [s for s in returned if (s["input_hexes"] or 0) >= 5000 and s["smooth_s"] is not None]
     fast = [s for s in sized if s["smooth_s"] <= 5 * s["refine_s"]]
     worst = max((s["smooth_s"] / s["refine_s"] for s in sized if s["refine_s"] > 0),
                 default=None)
     row("smoothing time <= 5 x the refinement's (CPU seconds, one thread), every case of >= "
         "5,000 input hexes", "%d met of %d (worst %s x)" % (len(fast), len(sized), fmt(worst)),
-        len(fast) == len(sized))
+        len(fast) == len(sized) if sized else "not in this run")
     meshes = {(s["folder"], s["mesh"]) for s in rows}
     outside = {m for m in meshes if any(s["source"] != "shared" for s in rows
                                         if (s["folder"], s["mesh"]) == m)}

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "mesh/conformity.hpp"
 #include "mesh/io.hpp"
 
 namespace hexrefine {
@@ -131,12 +132,54 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
               {"output", output}};
 }
 
-json real_mesh_study_cases(const std::vector<std::string>& mesh_files,
-                           const std::string& meshes_read_dir, const std::string& meshes_dir,
-                           const std::string& output) {
+const std::vector<std::string>& study_arms() {
+  static const std::vector<std::string> arms = {"trilinear", "default", "default-smooth"};
+  return arms;
+}
+
+namespace {
+
+/// `c` set up as `arm` of study_arms(): its placement and smoothing, passes > 1 with the buffer.
+json study_arm_case(json c, const std::string& arm, int passes) {
+  c["options"] = json::object();
+  // No placement given for the default arms: what a user who names none gets, with and without
+  // --smooth (the pipeline's default may differ between the two, issue 28 decision 2).
+  if (arm == "trilinear") c["options"]["placement"] = "trilinear";
+  c["smooth"] = arm == "default-smooth";
+  c["tags"]["arm"] = arm;
+  if (passes > 1) {
+    c["passes"] = passes;
+    c["options"]["buffer"] = "layer";
+  }
+  return c;
+}
+
+}  // namespace
+
+json real_mesh_study_cases(const std::vector<StudyMesh>& meshes, const std::string& output,
+                           int64_t max_hexes_input, std::vector<std::string>* skipped) {
   json cases = json::array();
-  for (const std::string& file : mesh_files) {
-    const HexMesh m = mesh_read(meshes_read_dir + "/" + file);
+  for (const StudyMesh& mesh : meshes) {
+    HexMesh m;
+    try {
+      m = mesh_read(mesh.path);
+    } catch (const std::exception& e) {
+      // "Every readable mesh": a file that does not read is named, not studied.
+      if (skipped) skipped->push_back(mesh.path + ": " + e.what());
+      continue;
+    }
+    if (m.hex_count() > max_hexes_input) {
+      if (skipped)
+        skipped->push_back(mesh.path + ": " + std::to_string(m.hex_count()) +
+                           " hexes, above the limit of " + std::to_string(max_hexes_input));
+      continue;
+    }
+    // The checker's verdict on the input decides whether a refusal is a defect (valid input) or
+    // the right answer (invalid input), so the report need not guess it from the message.
+    const MeshCheckReport input_check = mesh_check(m);
+    json defects = json::array();
+    for (const std::string& d : mesh_check_defects(input_check))
+      if (defects.size() < 3) defects.push_back(d.substr(0, 200));
     const auto [lo, hi] = mesh_bounding_box(m);
     const Eigen::Vector3d centre = (lo + hi) / 2;
     const double diagonal = (hi - lo).norm();
@@ -160,22 +203,21 @@ json real_mesh_study_cases(const std::vector<std::string>& mesh_files,
         {"two-passes", {sphere(0.1)}, 2},
     };
     // The case of the real-mesh issue: a ball at the rocker arm's origin.
-    if (file == "rockerarm.mesh") kinds.push_back({"issue-sphere", {"sphere:0,0,0,5"}, 1});
+    if (mesh.shared && mesh.file == "rockerarm.mesh")
+      kinds.push_back({"issue-sphere", {"sphere:0,0,0,5"}, 1});
+    const std::string prefix = mesh.shared ? mesh.file : mesh.folder + ":" + mesh.file;
     for (const Kind& kind : kinds)
-      for (const char* placement : {"trilinear", "optimized"}) {
-        json c = make_case(file + "/" + kind.name + "/" + placement,
-                           json{{"file", meshes_dir + "/" + file}}, kind.select,
+      for (const std::string& arm : study_arms()) {
+        json c = make_case(prefix + "/" + kind.name + "/" + arm, json{{"file", mesh.case_path}},
+                           kind.select,
                            {{"study", "real_meshes"},
-                            {"mesh", file},
+                            {"mesh", mesh.file},
+                            {"folder", mesh.folder},
+                            {"source", mesh.shared ? "shared" : "meshes"},
                             {"kind", kind.name},
-                            {"placement", placement}});
-        c["smooth"] = true;
-        c["options"] = {{"placement", placement}};
-        if (kind.passes > 1) {
-          c["passes"] = kind.passes;
-          c["options"]["buffer"] = "layer";
-        }
-        cases.push_back(c);
+                            {"input_valid", input_check.valid()},
+                            {"input_defects", defects}});
+        cases.push_back(study_arm_case(c, arm, kind.passes));
       }
   }
   // Anisotropic boxes: parents whose scaled Jacobian is 1 but whose edges differ by a factor a,
@@ -189,23 +231,21 @@ json real_mesh_study_cases(const std::vector<std::string>& mesh_files,
       const std::string select = "sphere:" + number_text(size[0] / 2) + "," +
                                  number_text(size[1] / 2) + "," + number_text(size[2] / 2) +
                                  ",0.01";
-      for (const char* placement : {"trilinear", "optimized"}) {
+      for (const std::string& arm : study_arms()) {
         json c =
-            make_case("aspect-" + number_text(a) + "-" + orientation + "/" + placement,
+            make_case("aspect-" + number_text(a) + "-" + orientation + "/" + arm,
                       json{{"generate", "brick"}, {"dims", {5, 5, 5}}, {"size", size}}, {select},
                       {{"study", "anisotropy"},
                        {"aspect", a},
                        {"orientation", orientation},
-                       {"placement", placement}});
-        c["smooth"] = true;
-        c["options"] = {{"placement", placement}};
-        cases.push_back(c);
+                       {"input_valid", true}});
+        cases.push_back(study_arm_case(c, arm, 1));
       }
     }
   return json{{"description",
-               "Real-mesh study (hexrefine study): every shared real mesh x region kind x both "
-               "methods x trilinear/optimized placement, smoothed; and one target hex among "
-               "anisotropic boxes; see results/real_meshes.md"},
+               "Real-mesh study (hexrefine study): every mesh x region kind x both methods x arm "
+               "(trilinear; default placement; default placement with --smooth); and one target "
+               "hex among anisotropic boxes; see results/real_meshes.md"},
               {"cases", cases},
               {"output", output}};
 }

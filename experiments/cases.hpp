@@ -22,6 +22,7 @@
 /// - Ablations (selective only): ranking off, propagation off, element-by-element only, on G-1
 ///   and on G-3 with n = 20.
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -34,18 +35,37 @@ namespace hexrefine {
 nlohmann::json thesis_suite_cases(bool quick, const std::string& meshes_dir,
                                   const std::string& output);
 
-/// The real-mesh study (`hexrefine study`): for each of `mesh_files` (names in `meshes_read_dir`,
-/// read here for their bounding boxes; `meshes_dir` is that folder as the case file sees it), the
-/// region kinds sphere (a ball about the bounding box's centre, radius 0.15 of its diagonal), grown
-/// blob (2 % of the hexes, at least 20, two seeds), boundary surface (the largest patch at 30
-/// degrees), scattered hexes (2 %, two seeds) and two passes with the buffer (a ball of 0.1 of the
-/// diagonal), plus rockerarm.mesh's sphere:0,0,0,5; both methods, trilinear and optimized
-/// placement, smoothed (the record keeps the unsmoothed check too). Then the anisotropy cases
-/// (tags study "anisotropy", aspect, orientation): one target hex in the middle of a 5x5x5 brick
-/// of boxes 1 x 1 x a ("long") or a x a x 1 ("flat"), a in 1, 1.5, 2, 3, 4, the same options.
-nlohmann::json real_mesh_study_cases(const std::vector<std::string>& mesh_files,
-                                     const std::string& meshes_read_dir,
-                                     const std::string& meshes_dir, const std::string& output);
+/// One mesh of the real-mesh study.
+struct StudyMesh {
+  std::string path;       ///< where this process reads it (absolute or relative to the cwd)
+  std::string case_path;  ///< the same file as the case file names it ("file")
+  std::string file;       ///< its file name, tagged "mesh" on every record
+  std::string folder;     ///< its folder as given (tag "folder"): "../shared/meshes" or --meshes
+  bool shared = true;     ///< from ../shared/meshes (tag "source": "shared"), else "meshes"
+};
+
+/// The arms of the study (issue 28, decisions 2 and 3), run on every (mesh, region kind, method):
+/// "trilinear" (the thesis' placement, unsmoothed: refusals counted, allowed), "default" (no
+/// placement given: the pipeline's default, unsmoothed) and "default-smooth" (no placement given,
+/// smoothed: the pipeline picks its start for --smooth; the record's options.placement.method
+/// says which). Each arm is a case of its own, so the unsmoothed arm's times are its own.
+const std::vector<std::string>& study_arms();
+
+/// The real-mesh study (`hexrefine study`): for each of `meshes` of at most `max_hexes_input`
+/// hexes (read here for their size, bounding box and checker verdict; the others are left out and
+/// named in `skipped`, as are unreadable files, "file: reason"), the region kinds sphere (a ball
+/// about the bounding box's centre, radius 0.15 of its diagonal), grown blob (2 % of the hexes, at
+/// least 20, two seeds), boundary surface (the largest patch at 30 degrees), scattered hexes (2 %,
+/// two seeds) and two passes with the buffer (a ball of 0.1 of the diagonal), plus rockerarm.mesh's
+/// sphere:0,0,0,5; both methods; each study_arms() arm. Tags: study "real_meshes", mesh, folder,
+/// source, kind, arm, input_valid (the checker's verdict on the input; a refusal of a valid input
+/// is a defect, of an invalid one the right answer) and input_defects. Case names: "FILE/KIND/ARM"
+/// for shared meshes, "FOLDER:FILE/KIND/ARM" for the others. Then the anisotropy cases (tags study
+/// "anisotropy", aspect, orientation, arm): one target hex in the middle of a 5x5x5 brick of boxes
+/// 1 x 1 x a ("long") or a x a x 1 ("flat"), a in 1, 1.5, 2, 3, 4, the same arms.
+nlohmann::json real_mesh_study_cases(const std::vector<StudyMesh>& meshes,
+                                     const std::string& output, int64_t max_hexes_input = INT64_MAX,
+                                     std::vector<std::string>* skipped = nullptr);
 
 /// Sweep intervals: 5, 10, ..., 75 (quick: ..., 30).
 std::vector<int> thesis_sweep_intervals(bool quick);

@@ -4,10 +4,12 @@
 ///   (cases.hpp) to results/thesis.jsonl, tables and plots by experiments/plots.py. The full
 ///   suite goes to results/, the quick one (sweeps up to n = 30) to results/quick/, so one never
 ///   overwrites the other.
-/// - `hexrefine study [--quick] [--resume] [--quiet] [--no-plots]`: the real-mesh study
-///   (real_mesh_study_cases) over every mesh of ../shared/meshes to results/real_meshes.jsonl,
-///   report and histograms by experiments/real_meshes_report.py; --quick: only the meshes of at
-///   most 200 hexes, to results/quick/.
+/// - `hexrefine study [--meshes DIR]... [--no-shared] [--max-hexes-input N] [--out DIR] [--quick]
+///   [--resume] [--quiet] [--no-plots]`: the real-mesh study (real_mesh_study_cases) over every
+///   mesh of ../shared/meshes and of each --meshes folder to results/real_meshes.jsonl, report
+///   and histograms by experiments/real_meshes_report.py; --quick: only the meshes of at most 200
+///   hexes, to results/quick/. The case file names the shared meshes relative to itself (a clean
+///   clone beside ../shared runs it) and the --meshes ones by absolute path (a user's folder).
 /// Each writes its case file beside its records, runs it through the runner and then the
 /// script; a failing script names the rerun command.
 
@@ -94,30 +96,83 @@ int reproduce_run(const CliArgs& a) {
           " --out " + shell_quote(results.string()));
 }
 
+/// The mesh files of `dir` (by extension, mesh_format_of), sorted by name.
+std::vector<std::string> mesh_files_of(const fs::path& dir) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_regular_file(ec)) continue;
+    try {
+      mesh_format_of(name);
+    } catch (const InputError&) {
+      continue;  // README, manifests and other files
+    }
+    files.push_back(name);
+  }
+  if (ec) throw InputError("hexrefine study: --meshes " + dir.string() + ": " + ec.message());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
 int study_run(const CliArgs& a) {
   if (!a.positional.empty())
     throw InputError("hexrefine study: unexpected argument '" + a.positional[0] + "'");
   const bool quick = a.flag("--quick");
-  const fs::path results = results_dir(quick);
-  const fs::path meshes = meshes_dir();
-  std::vector<std::string> files;
-  for (const auto& entry : fs::directory_iterator(meshes)) {
-    const std::string name = entry.path().filename().string();
-    try {
-      mesh_format_of(name);
-    } catch (const InputError&) {
-      continue;  // README and other files
-    }
-    if (quick && mesh_read(entry.path().string()).hex_count() > 200) continue;
-    files.push_back(name);
+  int64_t max_hexes = INT64_MAX;
+  if (const auto v = a.value("--max-hexes-input"))
+    max_hexes = cli_parse_int_in(*v, 1, INT64_MAX, "--max-hexes-input");
+  if (quick) max_hexes = std::min<int64_t>(max_hexes, 200);
+  fs::path results;
+  if (const auto out = a.value("--out")) {
+    results = fs::absolute(*out).lexically_normal();
+    std::error_code ec;
+    fs::create_directories(results, ec);
+    if (ec) throw InputError("hexrefine study: --out " + *out + ": cannot create: " + ec.message());
+  } else {
+    results = results_dir(quick);
   }
-  std::sort(files.begin(), files.end());
-  return suite_run(
-      a,
-      real_mesh_study_cases(files, meshes.string(), meshes.lexically_relative(results).string(),
-                            "real_meshes.jsonl"),
-      results / "real_meshes.cases.json", "real_meshes_report.py",
-      "--out " + shell_quote(results.string()));
+  const fs::path case_file = results / "real_meshes.cases.json";
+
+  std::vector<StudyMesh> meshes;
+  if (!a.flag("--no-shared")) {
+    // As the case file sees it: relative to its folder, so a clean clone beside ../shared runs.
+    const fs::path shared = fs::absolute(meshes_dir()).lexically_normal();
+    for (const std::string& file : mesh_files_of(shared))
+      meshes.push_back(StudyMesh{(shared / file).string(),
+                                 (shared.lexically_relative(results) / file).string(), file,
+                                 "../shared/meshes", true});
+  }
+  std::vector<fs::path> seen;
+  for (const std::string& given : a.all("--meshes")) {
+    std::error_code ec;
+    if (!fs::is_directory(given, ec))
+      throw InputError("hexrefine study: --meshes " + given + ": not a readable folder" +
+                       (fs::exists(given, ec) ? "" : " (no such file or folder)"));
+    const fs::path dir = fs::weakly_canonical(given, ec);
+    if (std::find(seen.begin(), seen.end(), dir) != seen.end()) continue;  // given twice
+    seen.push_back(dir);
+    // Absolute in the case file: the folder is the user's, outside the source tree.
+    for (const std::string& file : mesh_files_of(given))
+      meshes.push_back(
+          StudyMesh{(fs::path(given) / file).string(), (dir / file).string(), file, given, false});
+  }
+  if (meshes.empty())
+    throw InputError(
+        "hexrefine study: no mesh to study (--no-shared and no --meshes folder "
+        "holding a mesh file)");
+
+  std::vector<std::string> skipped;
+  nlohmann::json cases = real_mesh_study_cases(meshes, "real_meshes.jsonl", max_hexes, &skipped);
+  if (!skipped.empty()) {
+    std::string left_out = " Left out: ";
+    for (size_t i = 0; i < skipped.size(); ++i) left_out += (i ? "; " : "") + skipped[i];
+    cases["description"] = cases["description"].get<std::string>() + "." + left_out;
+    if (!a.flag("--quiet"))
+      for (const std::string& s : skipped) std::cerr << "hexrefine study: left out " << s << "\n";
+  }
+  return suite_run(a, cases, case_file, "real_meshes_report.py",
+                   "--out " + shell_quote(results.string()));
 }
 
 }  // namespace
@@ -139,15 +194,21 @@ const CliCommand cli_reproduce_command = {
 const CliCommand cli_study_command = {
     "study",
     "",
-    "Runs the real-mesh study (every shared mesh x region kind x method x placement, smoothed) "
-    "and writes results/real_meshes.md.",
+    "Runs the real-mesh study (every mesh x region kind x method x arm: trilinear, default "
+    "placement, default placement with --smooth) and writes results/real_meshes.md.",
     {
+        {"--meshes", "DIR",
+         "study every mesh file of DIR too, read from DIR as given (tagged with its folder)", true},
+        {"--no-shared", "", "leave out ../shared/meshes (only the --meshes folders)"},
+        {"--max-hexes-input", "N", "leave out the meshes of more than N hexes (named on stderr)"},
+        {"--out", "DIR", "write the case file, records and report to DIR (default results/)"},
         {"--quick", "", "only the meshes of at most 200 hexes, to results/quick/"},
         {"--resume", "", "keep the records already written"},
         {"--quiet", "", "no progress lines"},
         {"--no-plots", "", "records only: skip experiments/real_meshes_report.py"},
     },
-    "",
+    "Exit status 2 when a --meshes folder cannot be read. Each unreadable mesh file is left out "
+    "and named.",
     study_run,
 };
 

@@ -37,7 +37,8 @@ def fmt(value, digits=3):
 
 
 def study_cases(path, max_output_hexes):
-    """The optimized, refined cases of the real-mesh study (the records name their options)."""
+    """The optimized (default-arm), refined cases of the real-mesh study (the records name their
+    options)."""
     cases = []
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
@@ -49,7 +50,9 @@ def study_cases(path, max_output_hexes):
         except json.JSONDecodeError as error:
             fail("%s line %d: %s" % (path, number, error))
         tags = r.get("tags", {})
-        if tags.get("study") != "real_meshes" or tags.get("placement") != "optimized":
+        # Records before issue 28 tag placement "optimized"; since, the unsmoothed default arm.
+        if tags.get("study") != "real_meshes" or (tags.get("placement") != "optimized"
+                                                  and tags.get("arm") != "default"):
             continue
         if r.get("error") or r["check"]["hexes"] > max_output_hexes:
             continue

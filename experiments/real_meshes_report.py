@@ -3,17 +3,21 @@
 
 usage: real_meshes_report.py RECORDS.jsonl --out DIR [--quiet]
 
-Reads the records of `hexrefine study` (one per mesh x region kind x placement x method, each
-refined, checked, smoothed and checked again by the pipeline, algorithms/pipeline.hpp) and
-writes into DIR:
-  real_meshes.md                  the targets of the real-mesh issue, a summary per method and
-                                  placement, and every case
-  plots/real_meshes_quality.png   histograms of the outputs' scaled Jacobians per method and
-                                  placement (all cases summed), unsmoothed
-Exit status 2 on bad input.
+Reads the records of `hexrefine study` (one per mesh x region kind x arm x method; the arms of
+issue 28: `trilinear` unsmoothed, `default` unsmoothed, `default-smooth`, each run by the
+pipeline, algorithms/pipeline.hpp, and checked against its input) and writes into DIR:
+  real_meshes.md                  the targets of issue 28 (met and not met), the refusals of
+                                  valid inputs with their messages, a summary per mesh and per
+                                  arm, the anisotropy cases and every case
+  plots/real_meshes_quality.png   histograms of the outputs' scaled Jacobians per method and arm
+                                  (all cases summed; the smoothed arm's smoothed outputs)
+A record's arm is its tag "arm"; the placement it used is its options.placement.method (the
+pipeline picks the default's). The input counts as valid when the checker passed it (tag
+"input_valid", stamped by the case generator). Exit status 2 on bad input.
 """
 
 import argparse
+import json
 import os
 
 import matplotlib
@@ -24,7 +28,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 METHODS = ["selective", "sheet"]
-PLACEMENTS = ["trilinear", "optimized"]
+ARMS = ["trilinear", "default", "default-smooth"]
+EPS = 1e-12
 
 
 def fail(message):
@@ -33,6 +38,14 @@ def fail(message):
 
 def fmt(value, digits=3):
     return records.fmt(value, digits)
+
+
+def median(values):
+    values = sorted(values)
+    if not values:
+        return None
+    n = len(values)
+    return values[n // 2] if n % 2 else (values[n // 2 - 1] + values[n // 2]) / 2
 
 
 def share_below(histogram, limit=0.2):
@@ -47,67 +60,358 @@ def share_below(histogram, limit=0.2):
     return below / total
 
 
+def seconds(r, stage):
+    """A stage's CPU seconds (one thread: the better measure on a shared machine), else wall."""
+    cpu = r.get("stage_cpu_seconds", {})
+    return cpu[stage] if stage in cpu else r.get("stage_seconds", {}).get(stage, 0.0)
+
+
 def summarise(r):
-    """The numbers of one record, or None fields for a refusal."""
-    s = {"mesh": r["tags"]["mesh"], "kind": r["tags"]["kind"], "placement": r["tags"]["placement"],
-         "method": r["method"], "error": r.get("error")}
+    """The numbers of one record; a refusal keeps only its identification and message."""
+    t = r["tags"]
+    options = r.get("options", {})
+    placement = options.get("placement", {})
+    s = {"mesh": t["mesh"], "folder": t.get("folder", "../shared/meshes"),
+         "source": t.get("source", "shared"), "kind": t["kind"], "arm": t.get("arm"),
+         "method": r["method"], "error": r.get("error"),
+         "placement": placement.get("method", "?") if isinstance(placement, dict) else placement,
+         "smooth": options.get("smooth", False),
+         "input_valid": t.get("input_valid", True),
+         "input_hexes": r.get("input", {}).get("hexes"),
+         "input_min": r.get("input", {}).get("initial_min_scaled_jacobian")}
     if s["error"]:
         return s
     check = r["check"]
-    s["parents"] = r["refined_parents"]["min_scaled_jacobian"]
-    s["parents_count"] = r["refined_parents"]["hexes"]
+    parents = r["refined_parents"]
+    s["parents"] = parents["min_scaled_jacobian"]
+    s["parents_count"] = parents["hexes"]
     s["min"] = check["min_scaled_jacobian"]
     s["valid"] = check["valid"]
     s["hexes"] = check["hexes"]
-    s["input_hexes"] = r["input"]["hexes"]
     s["below"] = share_below(check["scaled_jacobian_histogram"])
-    s["histogram"] = check["scaled_jacobian_histogram"]
     smoothing = r.get("smoothing")
-    s["smoothed"] = smoothing["check"]["min_scaled_jacobian"] if smoothing else s["min"]
-    s["smoothed_valid"] = smoothing["check"]["valid"] if smoothing else s["valid"]
+    final = smoothing["check"] if smoothing else check
+    s["histogram"] = final["scaled_jacobian_histogram"]
+    s["smoothed"] = final["min_scaled_jacobian"] if smoothing else None
+    s["smoothed_valid"] = final["valid"]
+    s["warning"] = smoothing.get("warning") if smoothing else None
     # Longest over shortest edge, largest over the mesh (older records: not measured).
     s["edge_ratio"] = check.get("max_edge_ratio")
-    s["smoothed_edge_ratio"] = smoothing["check"].get("max_edge_ratio") if smoothing \
-        else s["edge_ratio"]
+    s["smoothed_edge_ratio"] = final.get("max_edge_ratio") if smoothing else None
     # The children of the refined parents alone: the mesh-wide minimum also holds untouched input
     # hexes, which can be worse than every refined parent.
-    parents = r["refined_parents"]
     s["children"] = parents.get("children_min_scaled_jacobian", s["min"])
-    s["children_smoothed"] = parents.get("smoothed_children_min_scaled_jacobian", s["children"])
-    stages = r["stage_seconds"]
-    s["refine_s"] = stages.get("refine", 0.0)
-    s["placement_s"] = r["refine"]["placement"]["seconds"]
-    s["smooth_s"] = stages.get("smooth", 0.0)
+    s["children_smoothed"] = parents.get("smoothed_children_min_scaled_jacobian")
+    s["refine_s"] = seconds(r, "refine")
+    s["smooth_s"] = seconds(r, "smooth") if smoothing else None
+    s["ratio"] = s["smoothed"] / s["parents"] if s["smoothed"] is not None and s["parents"] > 0 \
+        else None
     return s
 
 
+def smoothing_failed(s):
+    """An error of the smoothed arm that names smoothing (not the refinement before it)."""
+    return bool(s["error"]) and s["arm"] == "default-smooth" and "smooth" in s["error"].lower()
+
+
+def first_line(message, width=160):
+    return message.replace("|", "/").replace("\n", " ").strip()[:width]
+
+
+def mesh_label(s):
+    return s["mesh"] if s["source"] == "shared" else "%s (%s)" % (s["mesh"], s["folder"])
+
+
+def left_out_of(records_path):
+    """The meshes `hexrefine study` left out, from the case file beside the records."""
+    path = os.path.join(os.path.dirname(os.path.abspath(records_path)),
+                        "real_meshes.cases.json")
+    try:
+        with open(path, encoding="utf-8") as f:
+            description = json.load(f).get("description", "")
+    except (OSError, ValueError):
+        return ""
+    marker = "Left out: "
+    if marker not in description:
+        return ""
+    # "PATH: REASON; ..." -> "FILE (REASON)": the folders are in the per-mesh table.
+    entries = []
+    for entry in description[description.index(marker) + len(marker):].split("; "):
+        path, _, reason = entry.partition(": ")
+        entries.append("%s (%s)" % (os.path.basename(path),
+                                    reason.replace(", above the limit of", " >")))
+    return "; ".join(entries)
+
+
+def targets_section(rows):
+    out = ["\n## Targets (issue 28)\n", "| target | measured | met |", "|---|---|---|"]
+
+    def row(target, measured, met):
+        out.append("| %s | %s | %s |" % (target, measured,
+                                         met if isinstance(met, str) else ("yes" if met else
+                                                                           "**no**")))
+
+    valid = [s for s in rows if s["input_valid"]]
+    for arm, what in (("default", "default placement, unsmoothed"),
+                      ("default-smooth", "default placement with `--smooth`")):
+        mine = [s for s in valid if s["arm"] == arm]
+        refused = [s for s in mine if s["error"] and not smoothing_failed(s)]
+        row("0 refusals of valid inputs (the checker passes them), %s" % what,
+            "%d refused of %d" % (len(refused), len(mine)), not refused)
+    trilinear = [s for s in valid if s["arm"] == "trilinear"]
+    row("(trilinear, the thesis' placement: refusals counted, allowed)",
+        "%d refused of %d" % (sum(1 for s in trilinear if s["error"]), len(trilinear)),
+        "reported only")
+    smoothed = [s for s in valid if s["arm"] == "default-smooth"]
+    returned = [s for s in smoothed if not s["error"]]
+    row("smoothing never fails: every smoothed case of a valid input returns a mesh",
+        "%d of %d (%d smoothing failures)" % (len(returned), len(smoothed),
+                                              sum(1 for s in smoothed if smoothing_failed(s))),
+        len(returned) == len(smoothed))
+    row("(smoothed cases whose report carries a smoothing warning, `smoothing.warning`)",
+        "%d of %d" % (sum(1 for s in returned if s["warning"]), len(returned)), "counted")
+    lower = [s for s in returned if s["smoothed"] is not None and s["smoothed"] < s["min"] - EPS]
+    row("`--smooth` never below its unsmoothed minimum", "%d of %d" % (
+        len(returned) - len(lower), len(returned)), not lower)
+    refined = [s for s in returned if s["parents_count"] > 0 and s["smoothed"] is not None]
+    met = [s for s in refined if s["smoothed"] >= 0.5 * s["parents"] - EPS]
+    row("smoothed >= 0.5 x the refined parents' minimum scaled Jacobian, every case",
+        "%d met, %d not met" % (len(met), len(refined) - len(met)), len(met) == len(refined))
+    children = [s for s in refined if s["children_smoothed"] is not None]
+    met_c = [s for s in children if s["children_smoothed"] >= 0.5 * s["parents"] - EPS]
+    row("the same over the children alone (untouched input hexes left out)",
+        "%d met, %d not met" % (len(met_c), len(children) - len(met_c)),
+        len(met_c) == len(children))
+    issue = [s for s in returned if s["kind"] == "issue-sphere"]
+    row("rockerarm `sphere:0,0,0,5` smoothed >= 0.5",
+        ", ".join("%s %s" % (s["method"], fmt(s["smoothed"], 4)) for s in issue) or "–",
+        all(s["smoothed"] >= 0.5 - EPS for s in issue) if issue else "not in this run")
+    sized = [s for s in returned if (s["input_hexes"] or 0) >= 5000 and s["smooth_s"] is not None]
+    fast = [s for s in sized if s["smooth_s"] <= 5 * s["refine_s"]]
+    worst = max((s["smooth_s"] / s["refine_s"] for s in sized if s["refine_s"] > 0),
+                default=None)
+    row("smoothing time <= 5 x the refinement's (CPU seconds, one thread), every case of >= "
+        "5,000 input hexes", "%d met of %d (worst %s x)" % (len(fast), len(sized), fmt(worst)),
+        len(fast) == len(sized) if sized else "not in this run")
+    meshes = {(s["folder"], s["mesh"]) for s in rows}
+    outside = {m for m in meshes if any(s["source"] != "shared" for s in rows
+                                        if (s["folder"], s["mesh"]) == m)}
+    valid_meshes = {(s["folder"], s["mesh"]) for s in valid}
+    row(">= 10 meshes", "%d meshes (%d valid inputs), %d from outside ../shared" % (
+        len(meshes), len(valid_meshes), len(outside)), len(valid_meshes) >= 10)
+    done = [s for s in rows if not s["error"]]
+    row("every output valid (checked against its input; smoothed ones after smoothing)",
+        "%d of %d" % (sum(1 for s in done if s["valid"] and s["smoothed_valid"]), len(done)),
+        all(s["valid"] and s["smoothed_valid"] for s in done))
+    # Decision 1: quality under the edge-ratio cap, max(20, the thesis placement's output).
+    trilinear_ratio = {(s["folder"], s["mesh"], s["kind"], s["method"]): s["edge_ratio"]
+                       for s in done if s["arm"] == "trilinear" and s["edge_ratio"] is not None}
+    for arm, key in (("default", "edge_ratio"), ("default-smooth", "smoothed_edge_ratio")):
+        mine = [s for s in done if s["arm"] == arm and s[key] is not None]
+        compared = [s for s in mine if (s["folder"], s["mesh"], s["kind"], s["method"])
+                    in trilinear_ratio]
+        over = [s for s in compared if s[key] > max(20.0, trilinear_ratio[
+            (s["folder"], s["mesh"], s["kind"], s["method"])]) * (1 + 1e-9)]
+        row("edge-ratio cap held, %s: largest edge ratio <= max(20, the trilinear output's)" % (
+            "default placement" if arm == "default" else "`--smooth`"),
+            "%d of %d (%d without a trilinear output to compare)%s" % (
+                len(compared) - len(over), len(compared), len(mine) - len(compared),
+                "" if not over else "; over: " + "; ".join(
+                    "%s %s %s %s" % (s["mesh"], s["kind"], s["method"], fmt(s[key]))
+                    for s in over[:6])), not over)
+    # Decision 3: retired as requirements, kept as figures.
+    plain = [s for s in done if s["arm"] == "default" and s["parents_count"] > 0]
+    retired = "retired (issue 28 decision 3): reported only"
+    row("unsmoothed default output min >= 0.3 x parents' min", "%d of %d" % (
+        sum(1 for s in plain if s["min"] >= 0.3 * s["parents"] - EPS), len(plain)), retired)
+    row("the same over the children alone", "%d of %d" % (
+        sum(1 for s in plain if s["children"] >= 0.3 * s["parents"] - EPS), len(plain)), retired)
+    row("rockerarm `sphere:0,0,0,5` unsmoothed (default) >= 0.16",
+        ", ".join("%s %s" % (s["method"], fmt(s["min"], 4)) for s in plain
+                  if s["kind"] == "issue-sphere") or "–", retired)
+
+    used = {}
+    for s in rows:
+        if not s["error"] or s["placement"] != "?":
+            used.setdefault(s["arm"], {}).setdefault(s["placement"], 0)
+            used[s["arm"]][s["placement"]] += 1
+    out.append("\nPlacement each arm used (the records' `options.placement.method`): " + "; ".join(
+        "*%s*: %s" % (arm, ", ".join("%s (%d runs)" % kv for kv in sorted(used[arm].items())))
+        for arm in ARMS if arm in used) + ". *Valid input*: the checker passes it (tag "
+        "`input_valid`); refusals of invalid inputs are the right answer and are not counted.")
+    return out
+
+
+def refusals_section(rows):
+    bad = [s for s in rows if s["error"] and s["input_valid"]]
+    out = ["\n## Refusals and failures on valid inputs\n"]
+    if not bad:
+        out.append("None.")
+        return out
+    out += ["| mesh | region | method | arm (placement) | message |", "|---|---|---|---|---|"]
+    for s in bad:
+        out.append("| %s | %s | %s | %s (%s) | %s |" % (mesh_label(s), s["kind"], s["method"],
+                                                        s["arm"], s["placement"],
+                                                        first_line(s["error"])))
+    return out
+
+
+def per_mesh_section(rows):
+    out = ["\n## Per mesh\n",
+           "*refused*: errors on a valid input in the default arms (trilinear's in brackets); "
+           "*smoothed / parents*: the smoothed output's minimum over the refined parents', worst "
+           "and median over the cases; *smooth / refine*: CPU time ratio, worst.\n",
+           "| mesh | folder | input hexes | input min SJ | input valid | runs | refused | "
+           "smoothed / parents worst | median | smooth / refine worst |",
+           "|---|---|---:|---:|---|---:|---:|---:|---:|---:|"]
+    order = []
+    for s in rows:
+        if (s["folder"], s["mesh"]) not in order:
+            order.append((s["folder"], s["mesh"]))
+    for key in order:
+        g = [s for s in rows if (s["folder"], s["mesh"]) == key]
+        first = g[0]
+        refused = sum(1 for s in g if s["error"] and s["input_valid"] and s["arm"] != "trilinear")
+        tri = sum(1 for s in g if s["error"] and s["input_valid"] and s["arm"] == "trilinear")
+        ratios = [s["ratio"] for s in g if not s["error"] and s["ratio"] is not None
+                  and s["parents_count"] > 0]
+        times = [s["smooth_s"] / s["refine_s"] for s in g if not s["error"]
+                 and s["smooth_s"] is not None and s["refine_s"] > 0]
+        out.append("| %s | %s | %s | %s | %s | %d | %d (%d) | %s | %s | %s |" % (
+            first["mesh"], first["folder"], fmt(first["input_hexes"]), fmt(first["input_min"]),
+            "yes" if first["input_valid"] else "no", len(g), refused, tri,
+            fmt(min(ratios, default=None)), fmt(median(ratios)), fmt(max(times, default=None))))
+    return out
+
+
+def per_arm_section(rows):
+    out = ["\n## Summary per method and arm\n",
+           "| method | arm | runs | refused | output min / parents (median) | smoothed / parents "
+           "(median) | worst output min | worst smoothed min | share below 0.2 (mean) | largest "
+           "edge ratio | refine s (sum) | smooth s (sum) |",
+           "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for m in METHODS:
+        for arm in ARMS:
+            g = [s for s in rows if s["method"] == m and s["arm"] == arm]
+            if not g:
+                continue
+            ok = [s for s in g if not s["error"]]
+            plain = [s["min"] / s["parents"] for s in ok if s["parents"] > 0]
+            smooth = [s["ratio"] for s in ok if s["ratio"] is not None]
+            edges = [s["smoothed_edge_ratio"] if s["smoothed_edge_ratio"] is not None
+                     else s["edge_ratio"] for s in ok]
+            edges = [e for e in edges if e is not None]
+            out.append("| %s | %s | %d | %d | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                m, arm, len(g), len(g) - len(ok), fmt(median(plain)), fmt(median(smooth)),
+                fmt(min((s["min"] for s in ok), default=None), 4),
+                fmt(min((s["smoothed"] for s in ok if s["smoothed"] is not None), default=None),
+                    4),
+                fmt(sum(s["below"] for s in ok) / len(ok)) if ok else "–",
+                fmt(max(edges, default=None)), fmt(sum(s["refine_s"] for s in ok)),
+                fmt(sum(s["smooth_s"] or 0.0 for s in ok))))
+    return out
+
+
 def anisotropy_section(records_):
-    """The anisotropy cases: output minimum per aspect ratio, orientation, placement, method."""
+    """The anisotropy cases: output minimum per aspect ratio, orientation, arm, method."""
     cell = {}
     for r in records_:
         t = r["tags"]
         if r.get("error"):
             value = "refused"
+        elif r.get("smoothing"):
+            value = fmt(r["smoothing"]["check"]["min_scaled_jacobian"], 3)
         else:
-            smoothed = r["smoothing"]["check"]["min_scaled_jacobian"] if r.get("smoothing") \
-                else r["check"]["min_scaled_jacobian"]
-            value = "%s (%s)" % (fmt(r["check"]["min_scaled_jacobian"], 3), fmt(smoothed, 3))
-        cell[(t["aspect"], t["orientation"], t["placement"], r["method"])] = value
+            value = fmt(r["check"]["min_scaled_jacobian"], 3)
+        cell[(t["aspect"], t["orientation"], t.get("arm"), r["method"])] = value
     keys = sorted({(a, o) for (a, o, _, _) in cell}, key=lambda k: (k[1] != "long", k[0]))
     out = ["\n## Anisotropic parents: what the parents' scaled Jacobian does not see\n",
            "One target hex in the middle of a 5x5x5 brick of boxes: *long* boxes 1 x 1 x a (the "
            "neighbours above and below the target hold a transition template in their small "
-           "face), *flat* boxes a x a x 1. Every parent has scaled Jacobian 1, so the target "
-           "above asks for 0.3 on all of them; the output minimum unsmoothed (smoothed in "
-           "brackets). Placement moves only new nodes: the input's nodes, half the corners "
-           "of a transition child, stay, and with them the child's long edge. Smoothing moves "
-           "the input's nodes too.\n",
-           "| aspect a | boxes | selective trilinear | selective optimized | sheet trilinear | "
-           "sheet optimized |", "|---:|---|---:|---:|---:|---:|"]
+           "face), *flat* boxes a x a x 1. Every parent has scaled Jacobian 1. Output minimum "
+           "per arm (the smoothed arm: after smoothing). Placement moves only new nodes: the "
+           "input's nodes, half the corners of a transition child, stay, and with them the "
+           "child's long edge. Smoothing moves the input's nodes too.\n",
+           "| aspect a | boxes | " + " | ".join("%s %s" % (m, a) for m in METHODS for a in ARMS) +
+           " |", "|---:|---|" + "---:|" * (len(METHODS) * len(ARMS))]
     for a, o in keys:
         out.append("| %s | %s | %s |" % (fmt(a), o, " | ".join(
-            cell.get((a, o, p, m), "–") for m in METHODS for p in PLACEMENTS)))
-    return "\n".join(out)
+            cell.get((a, o, arm, m), "–") for m in METHODS for arm in ARMS)))
+    return out
+
+
+def every_case_section(rows):
+    out = ["\n## Every case\n",
+           "One row per mesh, region and method; the three arms side by side. *parents*: the "
+           "minimum over the input hexes refined (default arm); *children smoothed*: the "
+           "smoothed arm's minimum over the refined parents' children alone; *edge ratio*: the "
+           "largest, trilinear / default / smoothed; *smooth / refine*: CPU seconds of the "
+           "smoothed arm's two stages.\n",
+           "| mesh | region | method | output hexes | parents min | trilinear min | default min "
+           "| smoothed min | smoothed / parents | children smoothed | edge ratio | refine s | "
+           "smooth s | smooth / refine |",
+           "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|"]
+    by = {}
+    order = []
+    for s in rows:
+        key = (s["folder"], s["mesh"], s["kind"], s["method"])
+        if key not in by:
+            order.append(key)
+        by.setdefault(key, {})[s["arm"]] = s
+
+    def value(s, field, digits=4):
+        if s is None:
+            return "–"
+        if s["error"]:
+            return "refused" if not smoothing_failed(s) else "smoothing failed"
+        return fmt(s[field], digits)
+
+    for key in order:
+        arms = by[key]
+        t, d, sm = arms.get("trilinear"), arms.get("default"), arms.get("default-smooth")
+        ref = next((s for s in (d, sm, t) if s and not s["error"]), None)
+        edge = " / ".join(value(s, f, 3) for s, f in ((t, "edge_ratio"), (d, "edge_ratio"),
+                                                      (sm, "smoothed_edge_ratio")))
+        ratio = None
+        if sm and not sm["error"] and sm["smooth_s"] is not None and sm["refine_s"] > 0:
+            ratio = sm["smooth_s"] / sm["refine_s"]
+        smoothed = value(sm, "smoothed")
+        if sm and not sm["error"] and sm["warning"]:
+            smoothed += " (warning)"
+        out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            mesh_label(ref or t or d or sm), key[2], key[3],
+            fmt(ref["hexes"]) if ref else "–", fmt(ref["parents"], 4) if ref else "–",
+            value(t, "min"), value(d, "min"), smoothed, value(sm, "ratio", 3),
+            value(sm, "children_smoothed"), edge,
+            fmt(sm["refine_s"]) if sm and not sm["error"] else "–",
+            fmt(sm["smooth_s"]) if sm and not sm["error"] else "–", fmt(ratio)))
+    return out
+
+
+def quality_plot(rows, path):
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=True)
+    for ax, m in zip(axes, METHODS):
+        for offset, arm in enumerate(ARMS):
+            g = [s for s in rows if s["method"] == m and s["arm"] == arm and not s["error"]]
+            if not g:
+                continue
+            h = g[0]["histogram"]
+            counts = [sum(s["histogram"]["counts"][i] for s in g) for i in range(len(h["counts"]))]
+            total = sum(counts) or 1
+            width = h["bin_width"]
+            lefts = [h["bin_edges_from"] + i * width for i in range(len(counts))]
+            ax.bar([x + width * (0.15 + 0.28 * offset) for x in lefts],
+                   [c / total for c in counts], width * 0.28, label=arm)
+        ax.set_title(m)
+        ax.set_xlabel("scaled Jacobian (outputs of all cases; smoothed arm after smoothing)")
+        ax.set_xlim(-0.1, 1.0)
+        ax.set_yscale("log")
+        ax.legend()
+    axes[0].set_ylabel("share of output hexes")
+    fig.tight_layout()
+    fig.savefig(path + ".tmp.png", dpi=110)
+    plt.close(fig)
+    os.replace(path + ".tmp.png", path)
 
 
 def main():
@@ -121,175 +425,38 @@ def main():
     anisotropy = [r for r in every if r.get("tags", {}).get("study") == "anisotropy"]
     if not study:
         fail("%s: no records of the real-mesh study" % args.records)
-    rows = [summarise(r) for r in study]
+    try:
+        rows = [summarise(r) for r in study]
+    except (KeyError, TypeError) as e:
+        fail("%s: a study record lacks %s" % (args.records, e))
     os.makedirs(os.path.join(args.out, "plots"), exist_ok=True)
 
-    out = ["# Real meshes: both refiners, both placements, smoothed\n",
-           "Generated by `hexrefine study` from `%s` (%d records, commit %s). Every shared mesh "
-           "of `../shared/meshes` x region kind (sphere, two grown blobs, the largest boundary "
-           "surface, two scattered sets, two passes with the buffer; rockerarm also the issue's "
-           "`sphere:0,0,0,5`) x method x node placement, each output checked against its input, "
-           "smoothed (`--smooth`: the refined region and two layers) and checked again. Quality "
-           "is the scaled Jacobian; *parents* is the minimum over the input hexes that were "
-           "refined.\n" % (os.path.basename(args.records), len(study),
-                           study[0].get("commit", "?")[:12])]
-
-    # Targets of the real-mesh issue.
-    valid_inputs = [s for s in rows if not (s["error"] and "scaled Jacobian <= 0" in s["error"])
-                    and not (s["error"] and "not valid" in s["error"])]
-    refused = [s for s in valid_inputs if s["error"]]
-    optimized = [s for s in rows if not s["error"] and s["placement"] == "optimized"]
-    ratio_ok = [s for s in optimized if s["min"] >= 0.3 * s["parents"] - 1e-12]
-    smooth_ok = [s for s in optimized if s["smoothed"] >= 0.5 * s["parents"] - 1e-12]
-    children_ok = [s for s in optimized if s["children"] >= 0.3 * s["parents"] - 1e-12]
-    children_smooth_ok = [s for s in optimized
-                          if s["children_smoothed"] >= 0.5 * s["parents"] - 1e-12]
-    smooth_never_lower = [s for s in rows if not s["error"] and s["smoothed"] >= s["min"] - 1e-12]
-    fast = [s for s in optimized if s["smooth_s"] <= 5 * s["refine_s"]]
-    # The issue's time target is for rockerarm-sized cases (10,600 input hexes): on the small
-    # meshes both phases take milliseconds and their ratio says little.
-    sized = [s for s in optimized if s["input_hexes"] >= 5000]
-    sized_fast = [s for s in sized if s["smooth_s"] <= 5 * s["refine_s"]]
-    issue = [s for s in optimized if s["kind"] == "issue-sphere" and s["method"] == "selective"]
-    done = [s for s in rows if not s["error"]]
-    # Edge-ratio cap (NodeOptimizerOptions::max_edge_ratio, 20): an optimized output's largest
-    # edge ratio against max(20, the trilinear output's of the same case).
-    trilinear_ratio = {(s["mesh"], s["kind"], s["method"]): s["edge_ratio"] for s in done
-                       if s["placement"] == "trilinear"}
-    capped = [s for s in optimized if s["edge_ratio"] is not None
-              and (s["mesh"], s["kind"], s["method"]) in trilinear_ratio]
-    def cap_of(s):
-        return max(20.0, trilinear_ratio[(s["mesh"], s["kind"], s["method"])]) * (1 + 1e-9)
-    capped_ok = [s for s in capped if s["edge_ratio"] <= cap_of(s)]
-    capped_smooth_ok = [s for s in capped if s["smoothed_edge_ratio"] <= cap_of(s)]
-    out.append("\n## Targets\n")
-    out.append("| target | measured |\n|---|---|")
-    # The target is the default (optimized) placement's; the thesis' trilinear positions invert
-    # children of distorted parents, which the pipeline refuses: counted beside it.
-    for placement in ("optimized", "trilinear"):
-        mine = [s for s in valid_inputs if s["placement"] == placement]
-        bad = [s for s in refused if s["placement"] == placement]
-        out.append("| 0 refusals on every valid mesh (conformal, every scaled Jacobian > 0), %s "
-                   "placement | %d refused of %d such records%s |" % (
-                       placement, len(bad), len(mine),
-                       "" if not bad else " (" + "; ".join(
-                           "%s %s %s" % (s["mesh"], s["kind"], s["method"]) for s in bad[:6]) +
-                       ("; ..." if len(bad) > 6 else "") + ")"))
-    out.append("| optimized, unsmoothed: output min >= 0.3 x parents' min | %d of %d |" % (
-        len(ratio_ok), len(optimized)))
-    out.append("| the same over the children alone (untouched input hexes left out) | %d of %d |" % (
-        len(children_ok), len(optimized)))
-    out.append("| rockerarm `sphere:0,0,0,5` (selective, optimized) >= 0.16 | %s |" % (
-        ", ".join(fmt(s["min"], 4) for s in issue) or "–"))
-    out.append("| `--smooth`: >= 0.5 x parents' min (optimized) | %d of %d |" % (
-        len(smooth_ok), len(optimized)))
-    out.append("| the same over the children alone (untouched input hexes left out) | %d of %d |" % (
-        len(children_smooth_ok), len(optimized)))
-    out.append("| `--smooth` never below the unsmoothed mesh | %d of %d |" % (
-        len(smooth_never_lower), len(done)))
-    out.append("| `--smooth` at most 5x the refinement time (optimized) | %d of %d |" % (
-        len(fast), len(optimized)))
-    out.append("| the same on the rockerarm-sized inputs (5,000 hexes or more) | %d of %d |" % (
-        len(sized_fast), len(sized)))
-    out.append("| no edge collapsed (added here): optimized output's largest edge ratio <= max(20, "
-               "the trilinear output's; with two passes, pass 2 starts from pass 1's placed "
-               "nodes, not the trilinear ones) | %d of %d%s |" % (
-                   len(capped_ok), len(capped), "" if len(capped_ok) == len(capped) else
-                   " (over: " + "; ".join("%s %s %s %s" % (s["mesh"], s["kind"], s["method"],
-                                                          fmt(s["edge_ratio"], 3))
-                                          for s in capped if s not in capped_ok) + ")"))
-    out.append("| the same after `--smooth` | %d of %d |" % (len(capped_smooth_ok), len(capped)))
-    # Where trilinear placement is not refused: does smoothing end higher from its positions?
-    smoothed_of = {(s["mesh"], s["kind"], s["method"], s["placement"]): s for s in done}
-    pairs = [(s, smoothed_of[(s["mesh"], s["kind"], s["method"], "trilinear")])
-             for s in optimized if (s["mesh"], s["kind"], s["method"], "trilinear") in smoothed_of]
-    out.append("| (observed) `--smooth` from the trilinear positions instead of the optimized ones, "
-               "where trilinear is valid: higher / lower / equal; >= 0.5 x parents' min | "
-               "%d / %d / %d of %d; %d (from optimized: %d) |" % (
-                   sum(t["smoothed"] > o["smoothed"] + 1e-6 for o, t in pairs),
-                   sum(t["smoothed"] < o["smoothed"] - 1e-6 for o, t in pairs),
-                   sum(abs(t["smoothed"] - o["smoothed"]) <= 1e-6 for o, t in pairs), len(pairs),
-                   sum(t["smoothed"] >= 0.5 * t["parents"] - 1e-12 for _, t in pairs),
-                   sum(o["smoothed"] >= 0.5 * o["parents"] - 1e-12 for o, _ in pairs)))
-    out.append("| every output written valid (checked against its input) | %d of %d |" % (
-        sum(1 for s in done if s["valid"] and s["smoothed_valid"]), len(done)))
-
-    out.append("\n## Summary per method and placement\n")
-    out.append("| method | placement | cases | refused | min output / parents (median) | "
-               "worst output min | share below 0.2 (mean) | smoothed worst min | largest edge "
-               "ratio (smoothed) | refine s (sum) | placement s (sum) | smooth s (sum) |")
-    out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    for m in METHODS:
-        for p in PLACEMENTS:
-            g = [s for s in rows if s["method"] == m and s["placement"] == p]
-            ok = [s for s in g if not s["error"]]
-            ratios = sorted(s["min"] / s["parents"] for s in ok if s["parents"] > 0)
-            ratios_e = [s["edge_ratio"] for s in ok if s["edge_ratio"] is not None]
-            ratios_se = [s["smoothed_edge_ratio"] for s in ok
-                         if s["smoothed_edge_ratio"] is not None]
-            out.append("| %s | %s | %d | %d | %s | %s | %s | %s | %s (%s) | %s | %s | %s |" % (
-                m, p, len(g), len(g) - len(ok),
-                fmt(ratios[len(ratios) // 2]) if ratios else "–",
-                fmt(min((s["min"] for s in ok), default=None), 4),
-                fmt(sum(s["below"] for s in ok) / len(ok)) if ok else "–",
-                fmt(min((s["smoothed"] for s in ok), default=None), 4),
-                fmt(max(ratios_e, default=None), 3), fmt(max(ratios_se, default=None), 3),
-                fmt(sum(s["refine_s"] for s in ok)), fmt(sum(s["placement_s"] for s in ok)),
-                fmt(sum(s["smooth_s"] for s in ok))))
-
+    left_out = left_out_of(args.records)
+    out = ["# Real meshes: both refiners, three arms\n",
+           "Generated by `hexrefine study` from `%s` (%d records, commit %s). Every mesh of "
+           "`../shared/meshes` and of the `--meshes` folders x region kind (sphere, two grown "
+           "blobs, the largest boundary surface, two scattered sets, two passes with the buffer; "
+           "rockerarm also the issue's `sphere:0,0,0,5`) x method x arm: *trilinear* (the "
+           "thesis' placement, unsmoothed), *default* (no placement given, unsmoothed) and "
+           "*default-smooth* (no placement given, `--smooth`), each a run of its own, each "
+           "output checked against its input. Quality is the scaled Jacobian; *parents* is the "
+           "minimum over the input hexes that were refined.%s\n" % (
+               os.path.basename(args.records), len(study), study[0].get("commit", "?")[:12],
+               (" Left out: " + left_out + ".") if left_out else "")]
+    out += targets_section(rows)
+    out += refusals_section(rows)
+    out += per_mesh_section(rows)
+    out += per_arm_section(rows)
     if anisotropy:
-        out.append(anisotropy_section(anisotropy))
-
-    out.append("\n## Every case\n")
-    out.append("*children*: the minimum over the hexes made by refining the parents, unsmoothed "
-               "and smoothed; *output* and *smoothed*: over the whole mesh.\n")
-    out.append("| mesh | region | method | placement | output hexes | parents min | output min "
-               "| children min | smoothed min | children smoothed | below 0.2 | edge ratio "
-               "(smoothed) | refine s | of it placement s | smooth s |")
-    out.append("|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    for s in rows:
-        if s["error"]:
-            out.append("| %s | %s | %s | %s | refused: %s | | | | | | | | | | |" % (
-                s["mesh"], s["kind"], s["method"], s["placement"],
-                s["error"].replace("|", "/").replace("\n", " ")[:140]))
-            continue
-        out.append("| %s | %s | %s | %s | %s | %s | %s%s | %s | %s | %s | %s | %s (%s) | %s | %s "
-                   "| %s |" % (
-            s["mesh"], s["kind"], s["method"], s["placement"], fmt(s["hexes"]),
-            fmt(s["parents"], 4), fmt(s["min"], 4), "" if s["valid"] else " INVALID",
-            fmt(s["children"], 4), fmt(s["smoothed"], 4), fmt(s["children_smoothed"], 4),
-            "%.1f%%" % (100 * s["below"]), fmt(s["edge_ratio"], 3),
-            fmt(s["smoothed_edge_ratio"], 3), fmt(s["refine_s"]),
-            fmt(s["placement_s"]), fmt(s["smooth_s"])))
+        out += anisotropy_section(anisotropy)
+    out += every_case_section(rows)
     path = os.path.join(args.out, "real_meshes.md")
     with open(path + ".tmp", "w", encoding="utf-8") as f:
         f.write("\n".join(out) + "\n")
     os.replace(path + ".tmp", path)
 
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=True)
-    for ax, m in zip(axes, METHODS):
-        for offset, p in enumerate(PLACEMENTS):
-            g = [s for s in rows if s["method"] == m and s["placement"] == p and not s["error"]]
-            if not g:
-                continue
-            h = g[0]["histogram"]
-            counts = [sum(s["histogram"]["counts"][i] for s in g) for i in range(len(h["counts"]))]
-            total = sum(counts) or 1
-            width = h["bin_width"]
-            lefts = [h["bin_edges_from"] + i * width for i in range(len(counts))]
-            ax.bar([x + width * (0.3 + 0.4 * offset) for x in lefts],
-                   [c / total for c in counts], width * 0.4, label=p)
-        ax.set_title(m)
-        ax.set_xlabel("scaled Jacobian (unsmoothed outputs, all cases)")
-        ax.set_xlim(-0.1, 1.0)
-        ax.set_yscale("log")
-        ax.legend()
-    axes[0].set_ylabel("share of output hexes")
-    fig.tight_layout()
     plot = os.path.join(args.out, "plots", "real_meshes_quality.png")
-    fig.savefig(plot + ".tmp.png", dpi=110)
-    plt.close(fig)
-    os.replace(plot + ".tmp.png", plot)
+    quality_plot(rows, plot)
     if not args.quiet:
         print("wrote %s and %s" % (path, plot))
 

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -424,18 +425,49 @@ TEST(RunMeshFileName, ReplacesPathCharacters) {
   EXPECT_EQ(run_mesh_file_name("a b:c", "sheet"), "a_b_c.sheet.vtu");
 }
 
-TEST(RealMeshStudy, IsAValidCaseFileWithEveryRegionKindAndTheAnisotropyCases) {
+TEST(RealMeshStudy, IsAValidCaseFileWithEveryRegionKindArmAndTheAnisotropyCases) {
   const std::string meshes = std::string(HEXREFINE_SHARED_DIR) + "/meshes";
-  const json root =
-      real_mesh_study_cases({"rockerarm.mesh", "sphere_sculpt.e"}, meshes, meshes, "r.jsonl");
+  std::vector<StudyMesh> files;
+  for (const char* file : {"rockerarm.mesh", "sphere_sculpt.e", "sphere_projected_inverted.mesh"})
+    files.push_back({meshes + "/" + file, meshes + "/" + file, file, "../shared/meshes", true});
+  // The same file from a folder given with --meshes: named apart, tagged with its folder.
+  files.push_back({meshes + "/sphere_sculpt.e", meshes + "/./sphere_sculpt.e", "sphere_sculpt.e",
+                   "corpus", false});
+  files.push_back({meshes + "/no_such.mesh", "no_such.mesh", "no_such.mesh", "corpus", false});
+  std::vector<std::string> skipped;
+  const json root = real_mesh_study_cases(files, "r.jsonl", INT64_MAX, &skipped);
+  ASSERT_EQ(skipped.size(), 1u);
+  EXPECT_NE(skipped[0].find("no_such.mesh"), std::string::npos) << skipped[0];
   const RunPlan plan = run_plan_parse(root, "study.json", "/");
-  // 7 region kinds per mesh, rockerarm's issue ball, x 2 placements; then 9 box shapes (aspect
-  // 1 once, 1.5, 2, 3, 4 long and flat) x 2 placements.
-  EXPECT_EQ(plan.cases.size(), (7 + 1 + 7) * 2u + 9 * 2u);
-  int anisotropy = 0;
+  // 7 region kinds per mesh (4 meshes), rockerarm's issue ball, x 3 arms; then 9 box shapes
+  // (aspect 1 once, 1.5, 2, 3, 4 long and flat) x 3 arms.
+  EXPECT_EQ(plan.cases.size(), (7 * 4 + 1) * 3u + 9 * 3u);
+  std::map<std::string, int> arms;
+  int anisotropy = 0, invalid_inputs = 0, corpus = 0;
   for (const RunCase& c : plan.cases) {
-    EXPECT_TRUE(c.smooth) << c.name;
     EXPECT_EQ(c.methods, (std::vector<std::string>{"selective", "sheet"})) << c.name;
+    const std::string arm = c.tags.value("arm", "");
+    ++arms[arm];
+    // The arms of issue 28: trilinear and default unsmoothed, default smoothed. The default arms
+    // give no placement (the case file's default: optimized, until the pipeline picks its own).
+    EXPECT_EQ(c.smooth, arm == "default-smooth") << c.name;
+    EXPECT_EQ(c.options.placement.method == PlacementMethod::trilinear, arm == "trilinear")
+        << c.name;
+    EXPECT_EQ(c.name.substr(c.name.rfind('/') + 1), arm);
+    EXPECT_EQ(c.options.passes, c.tags.value("kind", "") == "two-passes" ? 2 : 1) << c.name;
+    if (c.tags.value("study", "") == "real_meshes") {
+      EXPECT_EQ(c.tags["source"], c.tags["folder"] == "corpus" ? "meshes" : "shared");
+      if (!c.tags["input_valid"].get<bool>()) {
+        ++invalid_inputs;
+        EXPECT_EQ(c.tags["mesh"], "sphere_projected_inverted.mesh");
+        EXPECT_FALSE(c.tags["input_defects"].empty());
+      }
+      if (c.tags["folder"] == "corpus") {
+        ++corpus;
+        EXPECT_EQ(c.mesh["file"], meshes + "/./sphere_sculpt.e");  // the case path, as given
+        EXPECT_EQ(c.name.rfind("corpus:sphere_sculpt.e/", 0), 0u) << c.name;
+      }
+    }
     if (c.tags.value("study", "") != "anisotropy") continue;
     ++anisotropy;
     EXPECT_EQ(c.mesh["generate"], "brick") << c.name;
@@ -443,9 +475,20 @@ TEST(RealMeshStudy, IsAValidCaseFileWithEveryRegionKindAndTheAnisotropyCases) {
     ASSERT_EQ(c.select.size(), 1u);
     EXPECT_EQ(c.select[0].rfind("sphere:", 0), 0u) << c.name;
   }
-  EXPECT_EQ(anisotropy, 18);
-  EXPECT_EQ(plan.cases.back().name, "aspect-4-flat/optimized");
+  EXPECT_EQ(arms, (std::map<std::string, int>{
+                      {"trilinear", 38}, {"default", 38}, {"default-smooth", 38}}));
+  EXPECT_EQ(anisotropy, 27);
+  EXPECT_EQ(invalid_inputs, 7 * 3);
+  EXPECT_EQ(corpus, 7 * 3);
+  EXPECT_EQ(plan.cases.back().name, "aspect-4-flat/default-smooth");
   EXPECT_EQ(plan.cases.back().mesh["size"], json({4.0, 4.0, 1.0}));
+
+  // --max-hexes-input: rockerarm (10,600 hexes) is left out and named, the small ones stay.
+  skipped.clear();
+  const json small = real_mesh_study_cases({files[0], files[1]}, "r.jsonl", 1000, &skipped);
+  ASSERT_EQ(skipped.size(), 1u);
+  EXPECT_NE(skipped[0].find("10600 hexes"), std::string::npos) << skipped[0];
+  EXPECT_EQ(small["cases"].size(), 7 * 3u + 9 * 3u);
 }
 
 TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {

@@ -114,7 +114,6 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
 /// record too): raised whenever a key is renamed, removed or changes its type or unit, or a key
 /// is added outside the objects the schema leaves open (docs/schema/report.schema.json; the
 /// changelog is in docs/report.md).
-/// pipeline_report writes it first, as "schema_version".
 inline constexpr int pipeline_report_schema_version = 1;
 
 /// The report: "method", "options" (RefineOptions plus "smooth"), "selection" ({"specs",

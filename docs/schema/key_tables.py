@@ -97,6 +97,14 @@ def tables(schemas):
                    f"{'yes' if key in record['required'] else 'no'} | "
                    f"{value.get('description', '')} |")
     out.append("")
+    m = record["properties"]["machine"]
+    out.append("#### `record.machine` (closed)\n")
+    out.append("| key | type | required | meaning |")
+    out.append("|---|---|---|---|")
+    for key, value in m["properties"].items():
+        out.append(f"| `{key}` | {type_text(value, schemas)} | "
+                   f"{'yes' if key in m['required'] else 'no'} | {value.get('description', '')} |")
+    out.append("")
     for branch in record["oneOf"]:
         out.append(f"#### `record`, {branch['title']} (besides the runner's keys)\n")
         out.append("| key | type | required | meaning |")

@@ -402,6 +402,7 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
 
 nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o) {
   nlohmann::json j;
+  j["schema_version"] = pipeline_report_schema_version;
   j["method"] = o.method;
   j["options"] = o.refine;
   j["options"]["smooth"] = o.smooth;

@@ -130,6 +130,12 @@ PipelineResult pipeline_run(const HexMesh& input, const PipelineOptions& options
 PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
                                   const PipelineOptions& options);
 
+/// The version of the report's keys (pipeline_report's "schema_version", stamped on every run
+/// record too): raised whenever a key is renamed, removed or changes its type or unit, or a key
+/// is added outside the objects the schema leaves open (docs/schema/report.schema.json; the
+/// changelog is in docs/report.md).
+inline constexpr int pipeline_report_schema_version = 1;
+
 /// The report: "method", "options" (RefineOptions plus "smooth"), "selection" ({"specs",
 /// "hexes", "warning"?}), "refine" (RefineStats), "refined_parents" ({"hexes",
 /// "min_scaled_jacobian", "children_min_scaled_jacobian",

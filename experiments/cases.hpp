@@ -16,7 +16,8 @@
 /// - H-2: 4x4x4 unit brick, `boundary:-1,0,0`, 3 passes, with the thesis' buffer rule
 ///   (PassBuffer::layer), and as ablations "H-2/none" and "H-2/transitions".
 /// - H-3 (mechanical plate, neck region): cube_minus_sphere_conforming.mesh,
-///   `sphere:0.275,0.275,0,0.15` (a ball about the middle of one of the cube's edges).
+///   `sphere:0.275,0.275,0,0.15` (a ball about the middle of one of the cube's edges); the
+///   selective method is expected to refuse it with trilinear placement ("expect").
 /// - H-4 (hook, every hex): rockerarm.mesh, `all`.
 /// - real/ellipsoid-sphere: ellipsoid.mesh, `sphere:0,0,0,0.15` (an interior ball).
 /// - Ablations (selective only): ranking off, propagation off, element-by-element only, on G-1

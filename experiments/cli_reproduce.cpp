@@ -70,8 +70,7 @@ int suite_run(const CliArgs& a, const nlohmann::json& cases, const fs::path& cas
   settings.environment = run_environment_detect();
   const RunSummary s = run_plan_execute(plan, settings, case_execute);
   if (!settings.quiet)
-    std::cout << "hexrefine: " << s.records_written << " records (" << s.records_skipped
-              << " already present, " << s.errors << " with an error) to " << s.output << "\n";
+    std::cout << "hexrefine: " << run_summary_counts(s) << " to " << s.output << "\n";
   if (a.flag("--no-plots")) return 0;
   const std::string cmd =
       "/usr/bin/python3 " +

@@ -10,12 +10,12 @@ namespace hexrefine {
 
 namespace {
 
-/// Prints the run's summary; error records are data (a refiner may refuse a case), so they do not
-/// fail the run, but a case whose input was bad (e.g. a selection spec) makes it exit 2.
+/// Prints the run's summary (expected refusals apart from errors); error records are data (a
+/// refiner may refuse a case), so they do not fail the run, but a case whose input was bad (e.g.
+/// a selection spec) makes it exit 2.
 int run_summary_report(const std::string& command, const RunSummary& s, bool quiet) {
   if (!quiet)
-    std::cout << "hexrefine " << command << ": " << s.records_written << " records written ("
-              << s.records_skipped << " already present, " << s.errors << " with an error) to "
+    std::cout << "hexrefine " << command << ": " << run_summary_counts(s) << " written to "
               << s.output << "\n";
   int64_t input_errors = 0;
   for (const nlohmann::json& r : jsonl_read(s.output).records)

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <thread>
 
+#include "algorithms/pipeline.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"
@@ -320,6 +321,16 @@ std::string run_mesh_file_name(const std::string& case_name, const std::string& 
   return name + "." + method + ".vtu";
 }
 
+std::string run_summary_counts(const RunSummary& s) {
+  std::string out = std::to_string(s.records_written) + " records (" +
+                    std::to_string(s.records_skipped) + " already present, " +
+                    std::to_string(s.refusals_expected) + " refused (expected), " +
+                    std::to_string(s.errors) + " with an error";
+  if (s.refusals_missing > 0)
+    out += ", " + std::to_string(s.refusals_missing) + " expected to be refused but refined";
+  return out + ")";
+}
+
 // --- the run ----------------------------------------------------------------------------------
 
 namespace {
@@ -415,8 +426,18 @@ RunSummary run_plan_execute(const RunPlan& plan, const RunSettings& settings,
                            {"cores", settings.environment.cores}};
       record["build_type"] = settings.environment.build_type;
       record["timestamp"] = run_timestamp_utc();
+      record["schema_version"] = pipeline_report_schema_version;
+      const bool refusal_expected =
+          std::find(c.refusals_expected.begin(), c.refusals_expected.end(), method) !=
+          c.refusals_expected.end();
+      if (refusal_expected) record["expect"] = "refused";
       for (auto& [k, v] : fields.items()) record[k] = std::move(v);
-      if (record.contains("error")) ++summary.errors;
+      if (!record.contains("error"))
+        summary.refusals_missing += refusal_expected;
+      else if (refusal_expected && record.value("error_kind", "") == "operation")
+        ++summary.refusals_expected;
+      else
+        ++summary.errors;
       try {
         jsonl_append(output, record);
       } catch (const OperationError& e) {

@@ -14,6 +14,7 @@
 ///               "options": {"ranking": true, "propagation": true, "ebe_only": false,
 ///                           "buffer": false, "allow_inverted": false,
 ///                           "placement": "optimized" | "trilinear"},
+///               "expect": "refused" | {"selective": "refused"},  // optional, see RunCase
 ///               "tags": {...}}],           // optional, copied into every record
 ///    "output": "path.jsonl"}
 /// Relative paths (mesh files, output) are relative to the case file's folder.
@@ -44,6 +45,11 @@ struct RunCase {
   /// Set by run_plan_execute when save_mesh: the folder "<output stem>.meshes" beside the output.
   std::string save_mesh_dir;
   nlohmann::json tags = nlohmann::json::object();
+  /// Methods this case expects to refuse ("expect": "refused" for all of them, or {"METHOD":
+  /// "refused"}), e.g. the thesis suite's H-3 with the thesis' trilinear positions, where a
+  /// template child inverts in a distorted parent. Their records carry "expect": "refused"; a
+  /// refusal of theirs (error_kind "operation") is counted as expected, not as an error.
+  std::vector<std::string> refusals_expected;
 };
 
 /// A parsed case file.
@@ -156,9 +162,17 @@ struct RunSettings {
 struct RunSummary {
   int64_t records_written = 0;
   int64_t records_skipped = 0;  ///< present already (resume)
-  int64_t errors = 0;           ///< records written with "error"
+  int64_t errors = 0;           ///< records written with "error", expected refusals left out
+  /// Records with "error" (error_kind "operation") of a method its case expects to refuse.
+  int64_t refusals_expected = 0;
+  /// Records of a method its case expects to refuse that were refined all the same.
+  int64_t refusals_missing = 0;
   std::string output;
 };
+
+/// "N records (S already present, R refused (expected), E with an error)", plus ", M expected to
+/// be refused but refined" when M > 0: the counts of the summary line of `run` and `reproduce`.
+std::string run_summary_counts(const RunSummary& summary);
 
 /// Runs the cases of `plan` in this shard through `execute` and appends a record per
 /// (case, method). Without resume the output starts empty; with resume, records whose key is

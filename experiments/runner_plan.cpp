@@ -104,7 +104,7 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
   schema_require_object(j, p);
   schema_allow_keys(j, p,
                     {"name", "description", "mesh", "select", "methods", "passes", "smooth",
-                     "save_mesh", "options", "tags"});
+                     "save_mesh", "options", "expect", "tags"});
   RunCase c;
   c.index = index;
   if (!j.contains("name")) p.fail("missing \"name\"");
@@ -187,6 +187,28 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
   }
   if (!j.contains("options") || !j["options"].contains("placement"))
     c.options.placement.method = pipeline_default_placement(c.smooth);
+  if (j.contains("expect")) {
+    // "refused" for every method of the case, or {"METHOD": "refused", ...} for listed methods.
+    const json& e = j["expect"];
+    const SchemaPath ep = p.at("expect");
+    auto expect_value = [](const json& v, const SchemaPath& vp) {
+      if (!v.is_string() || v.get<std::string>() != "refused")
+        vp.fail("expected \"refused\" (the only expectation a case can state)");
+    };
+    if (e.is_object()) {
+      if (e.empty()) ep.fail("expected \"refused\" or an object {\"METHOD\": \"refused\"}");
+      for (const auto& [method, value] : e.items()) {
+        if (std::find(c.methods.begin(), c.methods.end(), method) == c.methods.end())
+          ep.at(method).fail("method '" + method + "' is not one of the case's methods");
+        expect_value(value, ep.at(method));
+        c.refusals_expected.push_back(method);
+      }
+    } else {
+      if (!e.is_string()) ep.fail("expected \"refused\" or an object {\"METHOD\": \"refused\"}");
+      expect_value(e, ep);
+      c.refusals_expected = c.methods;
+    }
+  }
   if (j.contains("tags")) {
     schema_require_object(j["tags"], p.at("tags"));
     c.tags = j["tags"];

@@ -52,7 +52,10 @@ TEST(CliRun, ResumeOfAFinishedRunRunsNothing) {
   test_file_put(dir / "out" / "a.jsonl", done);
   const CliRun r = cli_run("run " + (dir / "c.json").string() + " --resume");
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("0 records written (2 already present"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("0 records (2 already present, 0 refused (expected), 0 with an error) "
+                          "written to"),
+            std::string::npos)
+      << r.output;
   EXPECT_EQ(test_file_text(dir / "out" / "a.jsonl"), done);
 }
 
@@ -113,7 +116,7 @@ TEST(CliRun, RunsBothMethodsOnTheSameTargetsAndChecksTheOutputs) {
   const CliRun r = cli_run("run " + (dir / "c.json").string());
   // The malformed spec is bad input: recorded, the run goes on, and it exits 2 at the end.
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("4 records written (0 already present, 1 with an error)"),
+  EXPECT_NE(r.output.find("4 records (0 already present, 0 refused (expected), 1 with an error)"),
             std::string::npos)
       << r.output;
   const JsonlContent c = jsonl_read((dir / "r.jsonl").string());
@@ -196,6 +199,35 @@ TEST(PlotsPy, PutsOursBesideTheThesisWithRatios) {
                               (dir / "out").string());
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.output.find("bad.jsonl:1: not a JSON record"), std::string::npos) << bad.output;
+}
+
+}  // namespace
+}  // namespace hexrefine
+
+namespace hexrefine {
+namespace {
+
+TEST(CliRun, AnExpectedRefusalIsNotAnError) {
+  // The thesis suite's H-3 with the thesis' trilinear positions: the selective templates invert
+  // children in distorted parents of the stand-in plate, a refusal the case marks as expected.
+  const auto dir = test_temp_dir("cli_run_expected_refusal");
+  test_file_put(dir / "c.json", R"({"cases":[{"name":"H-3","mesh":{"file":")" +
+                                    shared_mesh("cube_minus_sphere_conforming.mesh") +
+                                    R"("},"select":["sphere:0.275,0.275,0,0.15"],
+     "methods":["selective"],"options":{"placement":"trilinear"},
+     "expect":{"selective":"refused"}}],"output":"r.jsonl"})");
+  const CliRun r = cli_run("run " + (dir / "c.json").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 records (0 already present, 1 refused (expected), 0 with an error) "
+                          "written to"),
+            std::string::npos)
+      << r.output;
+  const JsonlContent c = jsonl_read((dir / "r.jsonl").string());
+  ASSERT_EQ(c.records.size(), 1u);
+  EXPECT_EQ(c.records[0]["expect"], "refused");
+  EXPECT_EQ(c.records[0]["error_kind"], "operation");
+  EXPECT_NE(c.records[0]["error"].get<std::string>().find("inverted"), std::string::npos)
+      << c.records[0].dump();
 }
 
 }  // namespace

@@ -364,6 +364,78 @@ TEST(RunPlanExecute, ErrorsBecomeRecordsAndTheRunGoesOn) {
   EXPECT_EQ(records[5]["final_hexes"], 1);
 }
 
+TEST(RunPlan, ExpectRefusedForTheCaseOrPerMethod) {
+  json all = brick_case("a"), one = brick_case("b");
+  all["expect"] = "refused";
+  one["expect"] = {{"sheet", "refused"}};
+  const RunPlan plan = run_plan_parse(json{{"cases", {all, one, brick_case("c")}}}, "m.json", "/");
+  EXPECT_EQ(plan.cases[0].refusals_expected, (std::vector<std::string>{"selective", "sheet"}));
+  EXPECT_EQ(plan.cases[1].refusals_expected, std::vector<std::string>{"sheet"});
+  EXPECT_TRUE(plan.cases[2].refusals_expected.empty());
+  auto error_of = [&](const json& expect, std::vector<std::string> methods = {}) {
+    json c = brick_case("x");
+    c["expect"] = expect;
+    if (!methods.empty()) c["methods"] = methods;
+    return input_error_of([&] { run_plan_parse(json{{"cases", {c}}}, "m.json", "/"); });
+  };
+  EXPECT_NE(error_of("failed").find("m.json: /cases/0/expect: expected \"refused\""),
+            std::string::npos);
+  EXPECT_NE(error_of(true).find("m.json: /cases/0/expect: expected \"refused\" or an object"),
+            std::string::npos);
+  EXPECT_NE(error_of(json::object()).find("/cases/0/expect: expected"), std::string::npos);
+  EXPECT_NE(error_of({{"sheet", "refused"}}, {"selective"})
+                .find("/cases/0/expect/sheet: method 'sheet' is not one of the case's methods"),
+            std::string::npos);
+  EXPECT_NE(error_of({{"sheet", "ok"}}).find("/cases/0/expect/sheet: expected \"refused\""),
+            std::string::npos);
+}
+
+TEST(RunPlanExecute, ExpectedRefusalsAreCountedApartFromErrors) {
+  const auto dir = test_temp_dir("runner_expected_refusals");
+  const std::string out = (dir / "r.jsonl").string();
+  json refused = brick_case("refused"), bad = brick_case("bad-input"), missed = brick_case("ok");
+  refused["expect"] = {{"selective", "refused"}};
+  bad["expect"] = "refused";
+  missed["expect"] = {{"sheet", "refused"}};
+  RunPlan plan = run_plan_parse(json{{"cases", {refused, bad, missed}}}, "m.json", "/");
+  plan.output = out;
+  // "refused": selective refuses (expected), sheet refuses too (not expected: an error);
+  // "bad-input": a bad input is an error even where a refusal is expected; "ok": both refine.
+  auto executor = [](const RunCase& c, const std::vector<std::string>& methods,
+                     const RunEmit& emit) {
+    for (const std::string& m : methods) {
+      if (c.name == "refused")
+        emit(m, json{{"error", "cannot refine"}, {"error_kind", "operation"}});
+      else if (c.name == "bad-input")
+        emit(m, json{{"error", "bad spec"}, {"error_kind", "input"}});
+      else
+        emit(m, json{{"final_hexes", 1}});
+    }
+  };
+  const RunSummary s = run_plan_execute(plan, quiet_settings(), executor);
+  EXPECT_EQ(s.records_written, 6);
+  EXPECT_EQ(s.refusals_expected, 1);
+  EXPECT_EQ(s.errors, 3);
+  EXPECT_EQ(s.refusals_missing, 1);
+  EXPECT_EQ(run_summary_counts(s),
+            "6 records (0 already present, 1 refused (expected), 3 with an error, 1 expected to "
+            "be refused but refined)");
+  const auto records = jsonl_read(out).records;
+  ASSERT_EQ(records.size(), 6u);
+  EXPECT_EQ(records[0]["expect"], "refused");
+  EXPECT_FALSE(records[1].contains("expect"));
+  EXPECT_EQ(records[2]["expect"], "refused");
+  EXPECT_EQ(records[3]["expect"], "refused");
+  EXPECT_FALSE(records[4].contains("expect"));
+  EXPECT_EQ(records[5]["expect"], "refused");
+  EXPECT_FALSE(records[5].contains("error"));
+  for (const json& r : records) EXPECT_EQ(r["schema_version"], 1) << r.dump();
+  RunSummary clean = s;
+  clean.refusals_missing = 0;
+  EXPECT_EQ(run_summary_counts(clean),
+            "6 records (0 already present, 1 refused (expected), 3 with an error)");
+}
+
 TEST(RunShard, ParsesOneBasedAndRefusesNonsense) {
   EXPECT_EQ(run_shard_parse("1/4"), (std::pair<int, int>{0, 4}));
   EXPECT_EQ(run_shard_parse("4/4"), (std::pair<int, int>{3, 4}));
@@ -530,6 +602,11 @@ TEST(ThesisSuite, IsAValidCaseFileWithBothMethodsOnEveryComparison) {
     for (const RunCase& c : plan.cases)
       if (c.save_mesh) saved.push_back(c.name);
     EXPECT_EQ(saved, (std::vector<std::string>{"G-1", "6-1", "H-1", "ring", "G-3/n=10"}));
+    // The one refusal the suite expects: H-3's selective method at the thesis' positions.
+    std::vector<std::string> expected;
+    for (const RunCase& c : plan.cases)
+      for (const std::string& m : c.refusals_expected) expected.push_back(c.name + ":" + m);
+    EXPECT_EQ(expected, std::vector<std::string>{"H-3:selective"});
     EXPECT_EQ(plan.cases[0].mesh["dims"], json({10, 10, 10}));
     EXPECT_EQ(plan.cases[0].select,
               (std::vector<std::string>{"boundary:-1,0,0", "boundary:0,0,-1"}));

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Installs hexrefine's build, test and plotting dependencies from Debian's packages (idempotent);
 # clang-14 and libclang-rt-14-dev (libFuzzer, ASan, UBSan) build the reader fuzz targets;
-# pybind11-dev, python3-dev, python3-numpy and python3-pytest build and test the Python module.
+# pybind11-dev, python3-dev, python3-numpy and python3-pytest build and test the Python module;
+# valgrind counts the instructions of the performance gate (hexrefine bench --instructions).
 set -euo pipefail
 packages=(cmake g++ make clang-format libeigen3-dev libopenmesh-dev nlohmann-json3-dev libgtest-dev
           libbenchmark-dev libexodusii-dev python3-meshio python3-vtk9 python3-matplotlib gmsh
           clang-14 libclang-rt-14-dev pybind11-dev python3-dev python3-numpy python3-pytest
-          zlib1g-dev)
+          zlib1g-dev valgrind)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -17,10 +17,12 @@
 ///   Debian 12's Valgrind 3.19 (its start/stop client requests came with 3.22).
 /// - One Valgrind process per workload, so that no workload's count depends on another's heap
 ///   or lazily built tables; `--jobs N` (default 2) run at once (the counts do not depend on
-///   it). Each runs with an empty environment (HEXREFINE_SHARED_DIR alone passed on, made
-///   absolute), in its own folder, ignoring ~/.valgrindrc (`--command-line-only=yes`): neither
-///   the caller's variables (GLIBC_TUNABLES, which this binary sets for huge pages, TMPDIR) nor
-///   their length reach the count.
+///   it). Each runs with an empty environment but HEXREFINE_SHARED_DIR, which names a link to
+///   the shared folder at a path of fixed length, in its own folder (also of fixed length),
+///   ignoring ~/.valgrindrc (`--command-line-only=yes`): neither the caller's variables
+///   (GLIBC_TUNABLES, which this binary sets for huge pages, TMPDIR) nor the length of a path
+///   reach the count (a path's length moves the heap's layout, and the alignment of a copied
+///   buffer changes the steps of memcpy: about a hundred instructions).
 /// - The JSON: "format" ("hexrefine-instructions"), "version" (1), "context" (date, commit,
 ///   whether the work tree had changes, host, tool, Valgrind's version, the compiler the driver
 ///   was built with, jobs, wall seconds of the run) and "benchmarks", in the driver's order:
@@ -30,6 +32,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -206,9 +209,16 @@ int bench_instructions_run(const CliArgs& a) {
         "hexrefine bench --instructions: valgrind not found in PATH (Debian: apt-get install "
         "valgrind; .ci/setup.sh installs it)");
 
-  std::vector<std::string> env;
-  if (const char* shared = std::getenv("HEXREFINE_SHARED_DIR"))
-    env.push_back("HEXREFINE_SHARED_DIR=" + std::filesystem::absolute(shared).string());
+  // The shared folder as the benchmarks find it (bench_util.hpp): HEXREFINE_SHARED_DIR, else
+  // beside the source tree of the build folder.
+  const char* shared_variable = std::getenv("HEXREFINE_SHARED_DIR");
+  const std::filesystem::path shared = std::filesystem::absolute(
+      shared_variable ? std::filesystem::path(shared_variable)
+                      : (self.parent_path() / "../../../shared").lexically_normal());
+  if (!std::filesystem::exists(shared / "meshes" / "rockerarm.mesh"))
+    throw OperationError("hexrefine bench --instructions: no " +
+                         (shared / "meshes" / "rockerarm.mesh").string() +
+                         " (set HEXREFINE_SHARED_DIR to the shared/ folder)");
 
   char scratch_template[] = "/tmp/hexrefine_bench_instructions_XXXXXX";
   if (!mkdtemp(scratch_template))
@@ -221,6 +231,13 @@ int bench_instructions_run(const CliArgs& a) {
       std::filesystem::remove_all(dir, e);
     }
   } cleanup{scratch};
+  // The driver finds the meshes through a link of a fixed path length: the strings it builds
+  // from the path, hence the heap's layout and the alignment of the buffers the workloads copy,
+  // are the same whatever the checkout's location.
+  std::filesystem::create_directory_symlink(shared, scratch / "shared", ec);
+  if (ec)
+    throw OperationError("hexrefine bench: cannot link " + shared.string() + ": " + ec.message());
+  const std::vector<std::string> env = {"HEXREFINE_SHARED_DIR=" + (scratch / "shared").string()};
 
   // The workloads, in the driver's order.
   const std::filesystem::path list_output = scratch / "list.txt";
@@ -242,7 +259,11 @@ int bench_instructions_run(const CliArgs& a) {
   std::vector<json> results(names.size());
   std::map<pid_t, Running> running;
   size_t next = 0, done = 0;
-  auto folder = [&](size_t i) { return scratch / std::to_string(i); };
+  // Folder names of one length (000, 001, ...): the result path is an argument of the driver.
+  auto folder = [&](size_t i) {
+    std::string digits = std::to_string(i);
+    return scratch / (std::string(3 - std::min<size_t>(3, digits.size()), '0') + digits);
+  };
   while (done < names.size()) {
     while (next < names.size() && static_cast<int>(running.size()) < jobs) {
       const std::filesystem::path dir = folder(next);

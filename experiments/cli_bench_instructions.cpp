@@ -22,13 +22,17 @@
 ///   ignoring ~/.valgrindrc (`--command-line-only=yes`): neither the caller's variables
 ///   (GLIBC_TUNABLES, which this binary sets for huge pages, TMPDIR) nor the length of a path
 ///   reach the count (a path's length moves the heap's layout, and the alignment of a copied
-///   buffer changes the steps of memcpy: about a hundred instructions).
+///   buffer changes the steps of memcpy: about a hundred instructions). Where allowed, each is
+///   pid 1 of a pid namespace of its own, so that the pid the writers put into their temporary
+///   file names is as long in every run.
 /// - The JSON: "format" ("hexrefine-instructions"), "version" (1), "context" (date, commit,
 ///   whether the work tree had changes, host, tool, Valgrind's version, the compiler the driver
 ///   was built with, jobs, wall seconds of the run) and "benchmarks", in the driver's order:
 ///   per workload its identity (name, operation, case, size, method, placement, format,
 ///   threads, description), "instructions" and "work" (the driver's counts of what was done).
 #include <fcntl.h>
+#include <sched.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -95,10 +99,19 @@ std::filesystem::path executable_in_path(const std::string& name) {
   return {};
 }
 
-/// Starts `argv` in folder `cwd` with environment `env`, stdout and stderr to `output`.
-/// Returns the child's pid; OperationError if it cannot be started.
+/// Enters a new pid namespace (as root, or through a new user namespace where unprivileged ones
+/// are allowed): the next child forked is its pid 1. False where neither is allowed.
+bool process_enter_pid_namespace() {
+  return unshare(CLONE_NEWPID) == 0 || unshare(CLONE_NEWUSER | CLONE_NEWPID) == 0;
+}
+
+/// Starts `argv` in folder `cwd` with environment `env`, stdout and stderr to `output`; with
+/// `pid_one`, as pid 1 of a pid namespace of its own (the started process waits for it and
+/// exits with its code; it dies with that process). Returns the child's pid; OperationError if
+/// it cannot be started.
 pid_t process_start(const std::vector<std::string>& argv, const std::vector<std::string>& env,
-                    const std::filesystem::path& cwd, const std::filesystem::path& output) {
+                    const std::filesystem::path& cwd, const std::filesystem::path& output,
+                    bool pid_one = false) {
   std::vector<char*> args, envp;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
@@ -107,6 +120,18 @@ pid_t process_start(const std::vector<std::string>& argv, const std::vector<std:
   const pid_t pid = fork();
   if (pid < 0) throw OperationError("hexrefine bench: cannot start " + argv[0]);
   if (pid == 0) {
+    if (pid_one) {
+      if (!process_enter_pid_namespace()) _exit(126);
+      const pid_t inner = fork();
+      if (inner < 0) _exit(127);
+      if (inner > 0) {
+        int status = 0;
+        while (waitpid(inner, &status, 0) < 0)
+          if (errno != EINTR) _exit(127);
+        _exit(WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status));
+      }
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+    }
     const int fd = open(output.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd < 0 || chdir(cwd.c_str()) != 0) _exit(127);
     dup2(fd, 1);
@@ -116,6 +141,17 @@ pid_t process_start(const std::vector<std::string>& argv, const std::vector<std:
     _exit(127);
   }
   return pid;
+}
+
+/// Whether this process may start workloads as pid 1 of their own pid namespace (a child tries).
+bool pid_namespaces_allowed() {
+  const pid_t pid = fork();
+  if (pid < 0) return false;
+  if (pid == 0) _exit(process_enter_pid_namespace() ? 0 : 1);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return false;
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
 /// Waits for `pid`; its exit code (128 + signal when killed).
@@ -254,6 +290,15 @@ int bench_instructions_run(const CliArgs& a) {
   if (names.empty()) throw OperationError("hexrefine bench: no workload matches --filter");
   const std::string valgrind_version = first_line_of("'" + valgrind.string() + "' --version");
 
+  // Writers name their temporary files after the process id, so a pid with another number of
+  // digits moves a writer's count (about 330 instructions a digit: 0.05 % of the VTU writer's
+  // 1.8 million from 4 digits to 1; results/bench/instructions_pid_digits.json). As pid 1 of a
+  // namespace of its own every workload has the same pid in every run.
+  const bool pid_one = pid_namespaces_allowed();
+  if (!pid_one)
+    std::cerr << "hexrefine bench: no pid namespaces here (unshare refused): the writers' counts "
+                 "may differ by a few hundred instructions with the pid's length\n";
+
   // Up to `jobs` Valgrind processes at once, each workload in a folder of its own.
   const auto started = std::chrono::steady_clock::now();
   std::vector<json> results(names.size());
@@ -280,7 +325,7 @@ int bench_instructions_run(const CliArgs& a) {
                                              names[next],
                                              "--result",
                                              (dir / "result.json").string()};
-      const pid_t pid = process_start(argv, env, dir, dir / "output.txt");
+      const pid_t pid = process_start(argv, env, dir, dir / "output.txt", pid_one);
       running[pid] = {next, std::chrono::steady_clock::now()};
       ++next;
     }
@@ -341,6 +386,7 @@ int bench_instructions_run(const CliArgs& a) {
   context["valgrind"] = valgrind_version;
   context["compiler"] = results.front().value("compiler", std::string("unknown"));
   context["jobs"] = jobs;
+  context["pid_namespace"] = pid_one;
   context["wall_seconds"] = std::round(wall * 10) / 10;
   if (filter) context["filter"] = *a.value("--filter");
   for (json& r : results) r.erase("compiler");

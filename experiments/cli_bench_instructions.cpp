@@ -378,7 +378,10 @@ int bench_instructions_run(const CliArgs& a) {
   std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   context["date"] = date;
   context["commit"] = first_line_of("git rev-parse HEAD");
-  context["dirty"] = first_line_of("git status --porcelain --untracked-files=no") != "unknown";
+  // Changes to the code, not to results/ (where this file itself usually goes).
+  context["dirty"] = first_line_of(
+                         "git status --porcelain --untracked-files=no -- ':/' "
+                         "':(top,exclude)results'") != "unknown";
   char host[256] = {};
   gethostname(host, sizeof host - 1);
   context["host"] = host;

@@ -16,10 +16,10 @@
 /// The workloads are those of `hexrefine bench --smoke` at the same sizes (the 10^3 bricks, the
 /// gear, rockerarm), without the two-thread variants (one thread here), with two passes of the
 /// thesis' H-2 case instead of three (332,448 and 370,304 hexes: alone beyond the 3-minute
-/// budget under Callgrind) and with placement and smoothing on the
-/// real mesh only (optimized placement on the bricks and the gear executes 1.3 to 5.5 billion
-/// instructions per workload). Every workload runs in a process of its own, so that one's heap
-/// or lazily built tables never change another's count. docs/performance-gate.md has the rest.
+/// budget under Callgrind) and with placement and smoothing on the real mesh only (optimized
+/// placement on the bricks and the gear executes 1.3 to 5.5 billion instructions per workload).
+/// Every workload runs in a process of its own, so that one's heap or lazily built tables never
+/// change another's count. docs/performance-gate.md has the rest.
 ///
 /// Usage:
 ///   instruction_workloads --list                       the workload names, one a line

@@ -3,11 +3,12 @@
 # clang-14 and libclang-rt-14-dev (libFuzzer, ASan, UBSan) build the reader fuzz targets;
 # pybind11-dev, python3-dev, python3-numpy and python3-pytest build and test the Python module;
 # python3-jsonschema validates reports and records against docs/schema/.
+# valgrind counts the instructions of the performance gate (hexrefine bench --instructions).
 set -euo pipefail
 packages=(cmake g++ make clang-format libeigen3-dev libopenmesh-dev nlohmann-json3-dev libgtest-dev
           libbenchmark-dev libexodusii-dev python3-meshio python3-vtk9 python3-matplotlib gmsh
           clang-14 libclang-rt-14-dev pybind11-dev python3-dev python3-numpy python3-pytest
-          python3-jsonschema zlib1g-dev)
+          python3-jsonschema zlib1g-dev valgrind)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -22,8 +22,12 @@
 /// - `bench --history FILE.jsonl` appends one line per run: commit (git, of the current folder),
 ///   date, machine, and per benchmark the median, minimum and maximum real and CPU seconds and
 ///   the number of repetitions; results/bench/plot_history.py draws it.
-/// - Exit codes: bench-compare returns 0 whatever the ratios (a comparison is information, not a
-///   verdict) and 2 for unreadable or malformed input; bench returns 1 if an executable fails.
+/// - Exit codes: bench-compare returns 0 whatever the ratios (a comparison of times is
+///   information, not a verdict) and 2 for unreadable or malformed input; bench returns 1 if an
+///   executable fails.
+/// - `bench --instructions` and `bench-compare --gate instructions` (the CI gate on instruction
+///   counts, which do not depend on the load) are cli_bench_instructions.cpp and
+///   cli_bench_gate.cpp.
 /// - Google Benchmark prints NaN (not JSON) for undefined statistics such as the coefficient of
 ///   variation of a counter that is always 0; both commands read such tokens as null.
 #include <sys/wait.h>
@@ -49,6 +53,7 @@
 
 #include "experiments/bench_statistics.hpp"
 #include "experiments/cli.hpp"
+#include "experiments/cli_bench.hpp"
 #include "experiments/process_huge_pages.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
@@ -339,6 +344,11 @@ void bench_history_append(const std::string& path, const json& merged, const Cli
 }
 
 int bench_run(const CliArgs& a) {
+  if (a.flag("--instructions")) return bench_instructions_run(a);
+  if (a.value("--jobs"))
+    throw InputError(
+        "hexrefine bench: --jobs is for --instructions (the timed suite runs one "
+        "benchmark at a time)");
   if (!a.positional.empty())
     throw InputError("hexrefine bench: unexpected argument '" + a.positional[0] + "'");
   std::string options = " --benchmark_format=json";
@@ -398,6 +408,7 @@ int bench_run(const CliArgs& a) {
 }
 
 int bench_compare_run(const CliArgs& a) {
+  if (a.value("--gate")) return bench_gate_run(a);
   if (a.positional.size() != 2)
     throw InputError("hexrefine bench-compare: expected BASE.json NEW.json");
   double threshold = 0.05;
@@ -479,11 +490,15 @@ const CliCommand cli_bench_command = {
     "",
     "Runs the bench_* Google Benchmark executables and merges their JSON.",
     {
-        {"--filter", "REGEX", "only the benchmarks whose name matches"},
+        {"--filter", "REGEX",
+         "only the benchmarks (with --instructions: the workloads) whose name matches"},
         {"--out", "FILE.json", "write the merged JSON here (default: stdout)"},
         {"--repetitions", "N", "repeat each benchmark N times (1..1000): median and spread"},
         {"--smoke", "", "smallest sizes only, minimal time (CI)"},
         {"--history", "FILE.jsonl", "append a record of this run (commit, date, machine, medians)"},
+        {"--instructions", "",
+         "count each workload's instructions under Callgrind instead (the CI gate's input)"},
+        {"--jobs", "N", "--instructions: Valgrind processes at once (1..64, default 2)"},
     },
     "",
     bench_run,
@@ -492,9 +507,12 @@ const CliCommand cli_bench_command = {
 const CliCommand cli_bench_compare_command = {
     "bench-compare",
     "BASE.json NEW.json",
-    "Compares two hexrefine bench files benchmark by benchmark (information, never fails).",
+    "Compares two hexrefine bench files benchmark by benchmark (times: information, never "
+    "fails; --gate instructions: the CI gate).",
     {
-        {"--threshold", "T", "flag ratios beyond 1 +- T (default 0.05)"},
+        {"--threshold", "T", "flag ratios beyond 1 +- T (default 0.05; with --gate 0.03)"},
+        {"--gate", "instructions",
+         "compare two bench --instructions files: exit 1 if a count grew by more than T"},
         {"--by", "cpu|real", "which time the flag follows (default cpu)"},
     },
     "",

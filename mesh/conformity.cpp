@@ -9,6 +9,7 @@
 #include <memory>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
@@ -101,6 +102,132 @@ bool face_lies_across_reference(const Quad& q, const QuadGrid& grid,
   for (const Eigen::Vector3d& c : q)
     if (grid.visit_cell(c, near)) return true;
   return false;
+}
+
+/// Two boundary faces of one mesh that touch: every corner of `face` is a node of `other` or
+/// lies on it (within mesh_check_surface_tolerance x its diameter), they face each other
+/// (opposite normals) and `face`'s hex lies beyond `other` (see conformity.hpp). `connected`:
+/// they share a node, or a corner of one is at a corner of the other (a node split in two).
+struct FaceContact {
+  int32_t face, other;
+  bool connected;
+};
+
+/// The boundary faces that touch another part of the boundary, split into gaps (non-conformal)
+/// and self-contact, both ascending (see conformity.hpp).
+struct BoundaryContacts {
+  std::vector<int32_t> gap_faces, self_contact_faces;
+};
+
+/// Whether p lies in the box of q's corners grown by `grow`: the patch lies in that box, so a
+/// point outside it is farther than `grow` from the patch.
+bool quad_box_contains(const Quad& q, const Eigen::Vector3d& p, double grow) {
+  for (int k = 0; k < 3; ++k) {
+    const double lo = std::min({q[0][k], q[1][k], q[2][k], q[3][k]});
+    const double hi = std::max({q[0][k], q[1][k], q[2][k], q[3][k]});
+    if (!(p[k] >= lo - grow && p[k] <= hi + grow)) return false;
+  }
+  return true;
+}
+
+/// The contact of boundary face i with boundary face j of `surface`, if they touch (FaceContact).
+std::optional<FaceContact> boundary_faces_touch(const HexMesh& mesh, const BoundarySurface& surface,
+                                                const std::vector<double>& tight, int32_t i,
+                                                int32_t j) {
+  const Quad& q = surface.quads[i];
+  const Quad& other = surface.quads[j];
+  const std::array<int32_t, 4>& nodes = surface.nodes[i];
+  const std::array<int32_t, 4>& other_nodes = surface.nodes[j];
+  bool connected = false;
+  for (int k = 0; k < 4; ++k) {
+    if (std::find(other_nodes.begin(), other_nodes.end(), nodes[k]) != other_nodes.end()) {
+      connected = true;
+      continue;
+    }
+    if (!quad_box_contains(other, q[k], tight[j]) || !quad_within(other, q[k], tight[j]))
+      return std::nullopt;
+    for (const Eigen::Vector3d& c : other)
+      if ((c - q[k]).norm() <= tight[j]) connected = true;
+  }
+  // Facing: the normal of i against the normal of j's patch where i's centroid projects.
+  const Eigen::Vector3d normal = quad_unit_normal(q);
+  if (normal.isZero()) return std::nullopt;
+  const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
+  const QuadProjection at = quad_closest_point(other, centroid);
+  const auto [su, sv] = quad_tangents(other, at.u, at.v);
+  Eigen::Vector3d other_normal = su.cross(sv);
+  if (other_normal.norm() > 0.0)
+    other_normal.normalize();
+  else
+    other_normal = quad_unit_normal(other);
+  if (!(normal.dot(other_normal) < 0.0)) return std::nullopt;
+  // Beyond: the centroid of the face opposite i in i's hex, on the outer side of j.
+  const HexCell& c = mesh.hexes[surface.slots[i].hex];
+  const int* opposite = hex_faces[hex_opposite_face[surface.slots[i].local_face]];
+  const Eigen::Vector3d far = (mesh.points[c[opposite[0]]] + mesh.points[c[opposite[1]]] +
+                               mesh.points[c[opposite[2]]] + mesh.points[c[opposite[3]]]) /
+                              4.0;
+  if (!((far - at.point).dot(other_normal) > tight[j])) return std::nullopt;
+  return FaceContact{i, j, connected};
+}
+
+/// Without a reference: the boundary faces that touch another part of the boundary, found from
+/// each face's first corner (the grid lists the faces within the tight tolerance of it), and
+/// grouped into contact patches (faces linked by a contact): a patch with a connected contact is
+/// a gap, the others self-contact.
+BoundaryContacts boundary_contacts(const HexMesh& mesh, const BoundarySurface& surface,
+                                   int threads) {
+  const int64_t faces = static_cast<int64_t>(surface.quads.size());
+  std::vector<double> tight(surface.quads.size());
+  for (int64_t i = 0; i < faces; ++i)
+    tight[i] = mesh_check_surface_tolerance * quad_diameter(surface.quads[i]);
+  const QuadGrid grid(surface.quads, tight);
+  constexpr int64_t chunk_faces = 1 << 12;
+  std::vector<std::vector<FaceContact>> found(
+      static_cast<size_t>(parallel_chunk_count(faces, chunk_faces)));
+  parallel_chunks(threads, faces, chunk_faces, [&](int64_t chunk, int64_t begin, int64_t end) {
+    for (int32_t i = static_cast<int32_t>(begin); i < end; ++i)
+      grid.find(surface.quads[i][0], [&](int32_t j) {
+        if (j == i) return false;
+        if (const std::optional<FaceContact> contact =
+                boundary_faces_touch(mesh, surface, tight, i, j))
+          found[chunk].push_back(*contact);
+        return false;
+      });
+  });
+  // Contact patches: union-find over the faces in a contact (few: none in most meshes).
+  std::vector<int32_t> members;
+  for (const std::vector<FaceContact>& list : found)
+    for (const FaceContact& c : list) {
+      members.push_back(c.face);
+      members.push_back(c.other);
+    }
+  std::sort(members.begin(), members.end());
+  members.erase(std::unique(members.begin(), members.end()), members.end());
+  auto index_of = [&](int32_t face) {
+    return static_cast<int32_t>(std::lower_bound(members.begin(), members.end(), face) -
+                                members.begin());
+  };
+  std::vector<int32_t> parent(members.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](int32_t k) {
+    while (parent[k] != k) k = parent[k] = parent[parent[k]];
+    return k;
+  };
+  for (const std::vector<FaceContact>& list : found)
+    for (const FaceContact& c : list) {
+      const int32_t a = root(index_of(c.face)), b = root(index_of(c.other));
+      parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<char> gap(members.size(), 0);
+  for (const std::vector<FaceContact>& list : found)
+    for (const FaceContact& c : list)
+      if (c.connected) gap[root(index_of(c.face))] = 1;
+  BoundaryContacts out;
+  for (size_t k = 0; k < members.size(); ++k)
+    (gap[root(static_cast<int32_t>(k))] ? out.gap_faces : out.self_contact_faces)
+        .push_back(members[k]);
+  return out;
 }
 
 double relative_error(double value, double reference) {
@@ -383,12 +510,9 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
                            (r.volume_relative_error <= mesh_check_geometry_tolerance &&
                             r.boundary_area_relative_error <= mesh_check_geometry_tolerance);
   } else {
-    const QuadGrid grid(surface.quads, surface.tolerances);
-    non_conformal = boundary_faces_where(threads, surface, [&](int32_t i) {
-      const Quad& q = surface.quads[i];
-      const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
-      return grid.find(centroid, [&](int32_t j) { return j != i; });
-    });
+    const BoundaryContacts contacts = boundary_contacts(mesh, surface, threads);
+    non_conformal = contacts.gap_faces;
+    r.self_contact_faces = static_cast<int64_t>(contacts.self_contact_faces.size());
   }
   r.non_conformal_faces = static_cast<int64_t>(non_conformal.size());
   for (int32_t i : non_conformal) defects.push_back(surface.slots[i].hex);
@@ -446,6 +570,7 @@ void to_json(nlohmann::json& j, const MeshCheckReport& r) {
   j["duplicate_nodes"] = r.duplicate_nodes;
   j["unused_nodes"] = r.unused_nodes;
   j["boundary_faces"] = r.boundary_faces;
+  j["self_contact_faces"] = r.self_contact_faces;
   j["min_scaled_jacobian"] = r.min_scaled_jacobian;
   j["mean_scaled_jacobian"] = r.mean_scaled_jacobian;
   j["max_edge_ratio"] = r.max_edge_ratio;

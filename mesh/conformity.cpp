@@ -408,14 +408,14 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   parallel_chunks(threads, r.hexes, chunk_hexes, [&](int64_t chunk, int64_t begin, int64_t end) {
     ChunkSums& s = sums[chunk];
     std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin)),
-        volumes(static_cast<size_t>(end - begin));
-    mesh_scaled_jacobians_and_volumes(mesh, static_cast<int32_t>(begin), scaled_jacobians, volumes);
+        volumes(static_cast<size_t>(end - begin)), edge_ratios(static_cast<size_t>(end - begin));
+    mesh_hex_measures(mesh, static_cast<int32_t>(begin), scaled_jacobians, volumes, edge_ratios);
     for (int32_t h = static_cast<int32_t>(begin); h < end; ++h) {
       const double sj = scaled_jacobians[h - begin];
       s.scaled_jacobian_sum += sj;
       s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
       s.volume += volumes[h - begin];
-      s.max_edge_ratio = std::max(s.max_edge_ratio, hex_edge_ratio(hex_points(mesh, h)));
+      s.max_edge_ratio = std::max(s.max_edge_ratio, edge_ratios[h - begin]);
       ++s.histogram[scaled_jacobian_bin(sj)];
       if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
         s.defects.push_back(h);

@@ -258,5 +258,64 @@ TEST(ConformityGaps, SelfContactIsReportedAndNoDefect) {
   EXPECT_FALSE(s.valid());
 }
 
+/// Trilinear map of hex `h` of `mesh` from the unit cube.
+Eigen::Vector3d hex_map(const HexMesh& mesh, int32_t h, double u, double v, double w) {
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  for (int c = 0; c < 8; ++c)
+    x += mesh.points[mesh.hexes[h][c]] *
+         ((hex_corner[c][0] ? u : 1 - u) * (hex_corner[c][1] ? v : 1 - v) *
+          (hex_corner[c][2] ? w : 1 - w));
+  return x;
+}
+
+TEST(ConformityGaps, NodesSlidOnAStronglyWarpedInputQuadStayOnItAndOffIsOff) {
+  // The input: one hex whose top face is warped by 0.18 of its diagonal (corner (1,1,1) raised
+  // to 1.5). The output: its 3 x 3 x 3 split by the trilinear map, then every new node of the
+  // top face slid on the top patch to other parameters (the footprints of the top children are
+  // no longer parameter rectangles, so their centroids leave the patch), as smoothing does.
+  HexMesh input = fixture_brick(1, 1, 1);
+  input.points[7].z() = 1.5;  // node 7 is corner (1,1,1) of the brick
+  const Quad top = {input.points[input.hexes[0][4]], input.points[input.hexes[0][5]],
+                    input.points[input.hexes[0][6]], input.points[input.hexes[0][7]]};
+  ASSERT_GT(quad_relative_warp(top), 0.15);
+  HexMesh out;
+  auto id = [](int i, int j, int k) { return static_cast<int32_t>(i + 4 * (j + 4 * k)); };
+  for (int k = 0; k <= 3; ++k)
+    for (int j = 0; j <= 3; ++j)
+      for (int i = 0; i <= 3; ++i) {
+        double u = i / 3.0, v = j / 3.0;
+        if (k == 3 && i > 0 && i < 3) u += (j == 1 ? 0.08 : -0.05);  // slid on the patch
+        if (k == 3 && j > 0 && j < 3) v += (i == 2 ? -0.07 : 0.04);
+        out.points.push_back(k == 3 ? quad_point(top, u, v) : hex_map(input, 0, u, v, k / 3.0));
+      }
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i)
+        out.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
+                             id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
+                             id(i, j + 1, k + 1)});
+  // The slide is real: some top child's centroid is off the patch by more than 1e-6 of its size.
+  double worst = 0;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d centroid =
+          (out.points[id(i, j, 3)] + out.points[id(i + 1, j, 3)] + out.points[id(i + 1, j + 1, 3)] +
+           out.points[id(i, j + 1, 3)]) /
+          4.0;
+      worst = std::max(worst, quad_distance(top, centroid));
+    }
+  ASSERT_GT(worst, 1e-4 * quad_diameter(top));
+  const MeshCheckReport r = mesh_check(out, &input);
+  EXPECT_EQ(r.inverted_hexes, 0);
+  EXPECT_EQ(r.non_conformal_faces, 0);
+  EXPECT_TRUE(r.valid());
+  // Off is off: one slid node lifted off the patch by twice the patch's warp.
+  HexMesh lifted = out;
+  lifted.points[id(1, 1, 3)] += 2 * quad_warp(top) * quad_unit_normal(top);
+  const MeshCheckReport off = mesh_check(lifted, &input);
+  EXPECT_EQ(off.non_conformal_faces, 4);  // the four top faces around the node
+  EXPECT_FALSE(off.valid());
+}
+
 }  // namespace
 }  // namespace hexrefine

@@ -3,8 +3,10 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <atomic>
+#include <climits>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -13,6 +15,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
 #include "mesh/hex_face_adjacency.hpp"
 #include "mesh/parallel.hpp"
@@ -119,19 +122,9 @@ struct BoundaryContacts {
   std::vector<int32_t> gap_faces, self_contact_faces;
 };
 
-/// Whether p lies in the box of q's corners grown by `grow`: the patch lies in that box, so a
-/// point outside it is farther than `grow` from the patch.
-bool quad_box_contains(const Quad& q, const Eigen::Vector3d& p, double grow) {
-  for (int k = 0; k < 3; ++k) {
-    const double lo = std::min({q[0][k], q[1][k], q[2][k], q[3][k]});
-    const double hi = std::max({q[0][k], q[1][k], q[2][k], q[3][k]});
-    if (!(p[k] >= lo - grow && p[k] <= hi + grow)) return false;
-  }
-  return true;
-}
-
 /// The contact of boundary face i with boundary face j of `surface`, if they touch (FaceContact).
 std::optional<FaceContact> boundary_faces_touch(const HexMesh& mesh, const BoundarySurface& surface,
+                                                const QuadGrid& grid,
                                                 const std::vector<double>& tight, int32_t i,
                                                 int32_t j) {
   const Quad& q = surface.quads[i];
@@ -144,8 +137,7 @@ std::optional<FaceContact> boundary_faces_touch(const HexMesh& mesh, const Bound
       connected = true;
       continue;
     }
-    if (!quad_box_contains(other, q[k], tight[j]) || !quad_within(other, q[k], tight[j]))
-      return std::nullopt;
+    if (!grid.box_contains(j, q[k]) || !quad_within(other, q[k], tight[j])) return std::nullopt;
     for (const Eigen::Vector3d& c : other)
       if ((c - q[k]).norm() <= tight[j]) connected = true;
   }
@@ -186,14 +178,19 @@ BoundaryContacts boundary_contacts(const HexMesh& mesh, const BoundarySurface& s
   std::vector<std::vector<FaceContact>> found(
       static_cast<size_t>(parallel_chunk_count(faces, chunk_faces)));
   parallel_chunks(threads, faces, chunk_faces, [&](int64_t chunk, int64_t begin, int64_t end) {
-    for (int32_t i = static_cast<int32_t>(begin); i < end; ++i)
-      grid.find(surface.quads[i][0], [&](int32_t j) {
-        if (j == i) return false;
-        if (const std::optional<FaceContact> contact =
-                boundary_faces_touch(mesh, surface, tight, i, j))
-          found[chunk].push_back(*contact);
+    for (int32_t i = static_cast<int32_t>(begin); i < end; ++i) {
+      // Every corner of i lies on the faces it touches, the first one too: those faces are
+      // registered in its cell. The faces around that corner pass the box test and fail at
+      // the next corner that is neither their node nor near them.
+      const Eigen::Vector3d& corner = surface.quads[i][0];
+      grid.visit_cell(corner, [&](int32_t j) {
+        if (j != i && grid.box_contains(j, corner))
+          if (const std::optional<FaceContact> contact =
+                  boundary_faces_touch(mesh, surface, grid, tight, i, j))
+            found[chunk].push_back(*contact);
         return false;
       });
+    }
   });
   // Contact patches: union-find over the faces in a contact (few: none in most meshes).
   std::vector<int32_t> members;
@@ -299,46 +296,84 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
       cell_of_point[i] = static_cast<uint32_t>(cell_of(k[0], k[1], k[2]));
     }
   });
-  std::vector<uint32_t> cell_end(static_cast<size_t>(cells), 0);  // counts, starts, then ends
-  for (int32_t i = 0; i < n; ++i) ++cell_end[cell_of_point[i]];
+  // Counting sort by cell over `parts` contiguous point ranges at once (as in
+  // hex_face_adjacency_build): each range counts its points per cell, a prefix over (cell, range)
+  // gives each range its place in every cell, and each range scatters its points there, so a
+  // cell's points stay in ascending order for any thread count. offsets[p][c] counts, then
+  // starts, then ends; the last range's ends are the cells' ends.
+  const int parts =
+      static_cast<int>(std::clamp<int64_t>(threads, 1, std::clamp<int64_t>(n / 65536, 1, 4)));
+  auto part_begin = [&](int p) { return static_cast<int32_t>(int64_t{n} * p / parts); };
+  std::vector<std::vector<uint32_t>> offsets(static_cast<size_t>(parts));
+  parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
+    std::vector<uint32_t>& count = offsets[p];
+    count.assign(static_cast<size_t>(cells), 0);
+    for (int32_t i = part_begin(static_cast<int>(p)); i < part_begin(static_cast<int>(p) + 1); ++i)
+      ++count[cell_of_point[i]];
+  });
   uint32_t running = 0;
-  for (uint32_t& c : cell_end) {
-    const uint32_t count = c;
-    c = running;
-    running += count;
-  }
-  std::unique_ptr<int32_t[]> sorted(new int32_t[n]);
-  for (int32_t i = 0; i < n; ++i) sorted[cell_end[cell_of_point[i]]++] = i;
+  for (int64_t c = 0; c < cells; ++c)
+    for (int p = 0; p < parts; ++p) {
+      const uint32_t count = offsets[p][c];
+      offsets[p][c] = running;
+      running += count;
+    }
+  // Each point with a key, its projection on a fixed direction of irrational slopes, rounded to
+  // float: two points within the tolerance have keys within key_tolerance (the projection moves
+  // by at most key_slopes x their distance, rounding to float by half a float ulp, at most
+  // 2^-24 x key_slopes x extent, each), so pairs are compared on their keys, next to each other in
+  // the cell, and only pairs with close keys read both points (scattered over the mesh). Structured
+  // grids, whose points share coordinates, have no two points with the same key in a cell.
+  const Eigen::Vector3d slopes(1.0, 0.7548776662, 0.5698402910);  // 1, 1/phi_3, 1/phi_3^2
+  const double key_slopes = slopes.sum();
+  const double key_tolerance =
+      (key_slopes * tolerance + std::ldexp(key_slopes * (hi - lo).maxCoeff(), -23)) * (1 + 1e-9);
+  auto key_of = [&](const Eigen::Vector3d& p) {
+    const double key = (p - lo).dot(slopes);
+    // NaN sorts last (as +infinity), so a sort by key is strict and no NaN pair is swept.
+    return std::isnan(key) ? std::numeric_limits<float>::infinity() : static_cast<float>(key);
+  };
+  struct KeyedPoint {
+    float key;
+    int32_t point;
+  };
+  std::unique_ptr<KeyedPoint[]> sorted(new KeyedPoint[n]);
+  parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
+    std::vector<uint32_t>& cursor = offsets[p];
+    for (int32_t i = part_begin(static_cast<int>(p)); i < part_begin(static_cast<int>(p) + 1); ++i)
+      sorted[cursor[cell_of_point[i]]++] = {key_of(mesh.points[i]), i};
+  });
+  const std::vector<uint32_t> cell_end = std::move(offsets.back());
+  offsets.clear();
   auto cell_begin = [&](int64_t c) { return c == 0 ? uint32_t{0} : cell_end[c - 1]; };
 
   // Pairs are compared per chunk of cells, then per chunk of points near a wall, on every thread;
   // a close pair marks its higher node (atomically: two chunks may mark the same node).
   std::vector<char> duplicate(n, 0);
-  auto compare = [&](int32_t i, int32_t j) {
-    if (i != j && (mesh.points[i] - mesh.points[j]).norm() <= tolerance)
-      std::atomic_ref<char>(duplicate[std::max(i, j)]).store(1, std::memory_order_relaxed);
+  auto compare = [&](const KeyedPoint& a, const KeyedPoint& b) {
+    if (a.point != b.point && std::abs(double{a.key} - double{b.key}) <= key_tolerance &&
+        (mesh.points[a.point] - mesh.points[b.point]).norm() <= tolerance)
+      std::atomic_ref<char>(duplicate[std::max(a.point, b.point)])
+          .store(1, std::memory_order_relaxed);
   };
-  // A crowded cell (a refined region is far denser than the bounding box's mean) is sorted by x
-  // and swept: only pairs within the tolerance in x are compared, so it costs k log k, not k^2.
+  // A crowded cell (a refined region is far denser than the bounding box's mean) is sorted by key
+  // and swept: only pairs within the key tolerance are compared, so it costs k log k, not k^2.
   parallel_chunks(threads, cells, chunk_points, [&](int64_t, int64_t begin, int64_t end) {
     for (int64_t c = begin; c < end; ++c) {
-      int32_t* first = sorted.get() + cell_begin(c);
-      int32_t* last = sorted.get() + cell_end[c];
+      KeyedPoint* first = sorted.get() + cell_begin(c);
+      KeyedPoint* last = sorted.get() + cell_end[c];
       if (last - first <= 16) {
-        for (int32_t* a = first; a < last; ++a)
-          for (int32_t* b = a + 1; b < last; ++b) compare(*a, *b);
+        for (KeyedPoint* a = first; a < last; ++a)
+          for (KeyedPoint* b = a + 1; b < last; ++b) compare(*a, *b);
         continue;
       }
-      // NaN sorts last (as +infinity), so the order is strict and no NaN pair is swept.
-      auto key = [&](int32_t i) {
-        const double x = mesh.points[i].x();
-        return std::isnan(x) ? std::numeric_limits<double>::infinity() : x;
-      };
-      std::sort(first, last, [&](int32_t i, int32_t j) {
-        return key(i) < key(j) || (key(i) == key(j) && i < j);
+      std::sort(first, last, [](const KeyedPoint& x, const KeyedPoint& y) {
+        return x.key < y.key || (x.key == y.key && x.point < y.point);
       });
-      for (int32_t* a = first; a < last; ++a)
-        for (int32_t* b = a + 1; b < last && key(*b) - key(*a) <= tolerance; ++b) compare(*a, *b);
+      for (KeyedPoint* a = first; a < last; ++a)
+        for (KeyedPoint* b = a + 1; b < last && double{b->key} - double{a->key} <= key_tolerance;
+             ++b)
+          compare(*a, *b);
     }
   });
   parallel_chunks(threads, static_cast<int64_t>(near_wall.size()), 1,
@@ -347,17 +382,58 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
                       int64_t k[3];
                       int low[3], high[3];
                       point_cell(mesh.points[i], k, low, high);
+                      const KeyedPoint self = {key_of(mesh.points[i]), i};
                       for (int dz = low[2]; dz <= high[2]; ++dz)
                         for (int dy = low[1]; dy <= high[1]; ++dy)
                           for (int dx = low[0]; dx <= high[0]; ++dx) {
                             if (dx == 0 && dy == 0 && dz == 0) continue;
                             const int64_t c = cell_of(k[0] + dx, k[1] + dy, k[2] + dz);
                             for (uint32_t b = cell_begin(c); b < cell_end[c]; ++b)
-                              compare(i, sorted[b]);
+                              compare(self, sorted[b]);
                           }
                     }
                   });
   return std::count(duplicate.begin(), duplicate.end(), 1);
+}
+
+/// The message mesh_validate_ids gives for the lowest of hexes [begin, end) whose node ids are
+/// out of range or repeated, if any.
+std::optional<std::string> hexes_bad_ids(const HexMesh& mesh, const std::string& what,
+                                         int64_t begin, int64_t end) {
+  using Four = int32_t __attribute__((vector_size(16)));
+  const int64_t n = static_cast<int64_t>(mesh.points.size());
+  // Ids are int32 and n at most 2^31: an id is in range when 0 <= id < n.
+  const Four limit = Four{} + static_cast<int32_t>(std::min<int64_t>(n, INT32_MAX));
+  const bool all_fit = n <= INT32_MAX;
+  for (int64_t h = begin; h < end; ++h) {
+    const HexCell& c = mesh.hexes[h];
+    // The range and the 28 pairs in eight vector compares of the two halves and their
+    // rotations; the loop below only names the defect.
+    Four lo, hi;
+    std::memcpy(&lo, c.data(), sizeof lo);
+    std::memcpy(&hi, c.data() + 4, sizeof hi);
+    const Four zero = {};
+    Four bad = (lo < zero) | (hi < zero);
+    if (all_fit) bad |= (lo >= limit) | (hi >= limit);
+    bad |= (lo == __builtin_shufflevector(lo, lo, 1, 2, 3, 0)) |
+           (lo == __builtin_shufflevector(lo, lo, 2, 3, 0, 1)) |
+           (hi == __builtin_shufflevector(hi, hi, 1, 2, 3, 0)) |
+           (hi == __builtin_shufflevector(hi, hi, 2, 3, 0, 1)) | (lo == hi) |
+           (lo == __builtin_shufflevector(hi, hi, 1, 2, 3, 0)) |
+           (lo == __builtin_shufflevector(hi, hi, 2, 3, 0, 1)) |
+           (lo == __builtin_shufflevector(hi, hi, 3, 0, 1, 2));
+    if ((bad[0] | bad[1] | bad[2] | bad[3]) == 0) continue;
+    for (int i = 0; i < 8; ++i) {
+      if (c[i] < 0 || c[i] >= n)
+        return what + ": hex " + std::to_string(h) + " refers to node " + std::to_string(c[i]) +
+               ", expected 0.." + std::to_string(n - 1);
+      for (int j = 0; j < i; ++j)
+        if (c[j] == c[i])
+          return what + ": hex " + std::to_string(h) + " repeats node " + std::to_string(c[i]) +
+                 " (degenerate hex)";
+    }
+  }
+  return std::nullopt;
 }
 
 /// Bin of scaled_jacobian_histogram.
@@ -369,44 +445,33 @@ int scaled_jacobian_bin(double v) {
 }  // namespace
 
 MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int threads) {
-  mesh_validate_ids(mesh, "mesh", threads);
-  if (reference) mesh_validate_ids(*reference, "reference mesh");
   MeshCheckReport r;
   r.hexes = mesh.hex_count();
   r.nodes = mesh.point_count();
-  // Unused and duplicate nodes first: their work arrays are gone before the faces are matched.
-  {
-    std::vector<char> used(mesh.points.size(), 0);
-    for (const HexCell& c : mesh.hexes)
-      for (int32_t v : c) used[v] = 1;
-    r.unused_nodes = std::count(used.begin(), used.end(), 0);
-  }
-  r.duplicate_nodes = count_duplicate_nodes(mesh, threads);
-  // Doublets come from the matching itself: no neighbour array (24 bytes per hex) is built.
-  HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, threads, false);
-  r.nonmanifold_faces = static_cast<int64_t>(adjacency.nonmanifold_faces.size());
 
-  // Hexes with a defect: every source offers its lowest mesh_check_defect_hex_limit, so the
-  // report lists the lowest overall.
-  std::vector<int32_t> defects;
-  for (const HexFaceSlot& f : adjacency.nonmanifold_faces) defects.push_back(f.hex);
-  r.doublets = static_cast<int64_t>(adjacency.doublets.size());
-  defects.insert(defects.end(), adjacency.doublets.begin(),
-                 adjacency.doublets.begin() +
-                     std::min(adjacency.doublets.size(), mesh_check_defect_hex_limit));
-
-  // Quality and volume, per fixed chunk of hexes so the sums do not depend on the thread count.
+  // One pass over the hexes: their ids checked (as mesh_validate_ids does, the lowest bad hex
+  // named), the nodes they use marked, and their quality and volume measured. Per fixed chunk of
+  // hexes, so the sums do not depend on the thread count.
   struct ChunkSums {
     double scaled_jacobian_sum = 0.0, volume = 0.0, min_scaled_jacobian = 1.0;
     double max_edge_ratio = 1.0;
     int64_t inverted = 0;
     std::array<int64_t, 20> histogram{};
     std::vector<int32_t> defects;  // ascending, at most the limit per kind
+    std::string bad_ids;           // the message for the chunk's lowest hex with bad ids
   };
   constexpr int64_t chunk_hexes = 1 << 14;
   std::vector<ChunkSums> sums(static_cast<size_t>(parallel_chunk_count(r.hexes, chunk_hexes)));
+  std::vector<char> used(mesh.points.size(), 0);
   parallel_chunks(threads, r.hexes, chunk_hexes, [&](int64_t chunk, int64_t begin, int64_t end) {
     ChunkSums& s = sums[chunk];
+    if (const std::optional<std::string> bad = hexes_bad_ids(mesh, "mesh", begin, end)) {
+      s.bad_ids = *bad;
+      return;
+    }
+    for (int64_t h = begin; h < end; ++h)
+      for (int32_t v : mesh.hexes[h])
+        std::atomic_ref<char>(used[v]).store(1, std::memory_order_relaxed);
     std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin)),
         volumes(static_cast<size_t>(end - begin)), edge_ratios(static_cast<size_t>(end - begin));
     mesh_hex_measures(mesh, static_cast<int32_t>(begin), scaled_jacobians, volumes, edge_ratios);
@@ -421,6 +486,30 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
         s.defects.push_back(h);
     }
   });
+  for (const ChunkSums& s : sums)
+    if (!s.bad_ids.empty()) throw InputError(s.bad_ids);
+  for (const HexAttribute& a : mesh.attributes)  // as mesh_validate_ids, after the hexes
+    if (a.values.size() != mesh.hexes.size())
+      throw InputError("mesh: attribute '" + a.name + "' has " + std::to_string(a.values.size()) +
+                       " values for " + std::to_string(mesh.hexes.size()) + " hexes");
+  if (reference) mesh_validate_ids(*reference, "reference mesh", threads);
+  r.unused_nodes = std::count(used.begin(), used.end(), 0);
+  used = {};
+
+  r.duplicate_nodes = count_duplicate_nodes(mesh, threads);
+  // Doublets come from the matching itself: no neighbour array (24 bytes per hex) is built.
+  HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, threads, false);
+  r.nonmanifold_faces = static_cast<int64_t>(adjacency.nonmanifold_faces.size());
+
+  // Hexes with a defect: every source offers its lowest mesh_check_defect_hex_limit, so the
+  // report lists the lowest overall.
+  std::vector<int32_t> defects;
+  for (const HexFaceSlot& f : adjacency.nonmanifold_faces) defects.push_back(f.hex);
+  r.doublets = static_cast<int64_t>(adjacency.doublets.size());
+  defects.insert(defects.end(), adjacency.doublets.begin(),
+                 adjacency.doublets.begin() +
+                     std::min(adjacency.doublets.size(), mesh_check_defect_hex_limit));
+
   double sum_scaled_jacobian = 0.0;
   r.scaled_jacobian_histogram.assign(20, 0);
   for (const ChunkSums& s : sums) {

@@ -1,6 +1,7 @@
 #include "mesh/hex_face_adjacency.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <memory>
 #include <string>
 
@@ -12,9 +13,16 @@ namespace hexrefine {
 
 namespace {
 
-int32_t face_lowest_node(const HexCell& c, int lf) {
-  const int* fv = hex_faces[lf];
-  return std::min(std::min(c[fv[0]], c[fv[1]]), std::min(c[fv[2]], c[fv[3]]));
+/// The lowest node of each of the six local faces of c, from eight pairwise minima (each face's
+/// four nodes are two of the pairs; hex_faces: f0 {0,4,7,3}, f1 {1,2,6,5}, f2 {0,1,5,4}, f3
+/// {3,7,6,2}, f4 {0,3,2,1}, f5 {4,5,6,7}).
+std::array<int32_t, 6> hex_face_lowest_nodes(const HexCell& c) {
+  const int32_t m01 = std::min(c[0], c[1]), m23 = std::min(c[2], c[3]);
+  const int32_t m45 = std::min(c[4], c[5]), m67 = std::min(c[6], c[7]);
+  const int32_t m03 = std::min(c[0], c[3]), m12 = std::min(c[1], c[2]);
+  const int32_t m47 = std::min(c[4], c[7]), m56 = std::min(c[5], c[6]);
+  return {std::min(m03, m47), std::min(m12, m56), std::min(m01, m45),
+          std::min(m23, m67), std::min(m01, m23), std::min(m45, m67)};
 }
 
 /// The three nodes of local face lf other than its lowest, ascending: with the lowest node (the
@@ -65,13 +73,34 @@ std::array<int32_t, 4> face_node_set(const HexCell& c, int lf) {
 /// they share. A second shared face holds two nodes of each hex outside the first (an edge of
 /// it, or all four when it is the opposite face), so the hexes' faces opposite la and lb have a
 /// node in common; that test, 16 comparisons in four vector compares of b's four nodes rotated
-/// against a's, settles almost every face (it runs once per interior face).
+/// against a's (each hex's four taken by one shuffle of its two halves), settles almost every
+/// face (it runs once per interior face).
+using Four = int32_t __attribute__((vector_size(16)));
+
+/// The four nodes of c outside its local face lf (those of the opposite face, in some order),
+/// from its two halves lo = c[0..3] and hi = c[4..7].
+Four hex_nodes_off_face(const HexCell& c, int lf) {
+  Four lo, hi;
+  std::memcpy(&lo, c.data(), sizeof lo);
+  std::memcpy(&hi, c.data() + 4, sizeof hi);
+  switch (lf) {
+    case 0:
+      return __builtin_shufflevector(lo, hi, 1, 2, 5, 6);  // f1 {1,2,6,5}
+    case 1:
+      return __builtin_shufflevector(lo, hi, 0, 3, 4, 7);  // f0 {0,4,7,3}
+    case 2:
+      return __builtin_shufflevector(lo, hi, 2, 3, 6, 7);  // f3 {3,7,6,2}
+    case 3:
+      return __builtin_shufflevector(lo, hi, 0, 1, 4, 5);  // f2 {0,1,5,4}
+    case 4:
+      return hi;  // f5 {4,5,6,7}
+    default:
+      return lo;  // f4 {0,3,2,1}
+  }
+}
+
 bool faces_make_doublet(const HexCell& a, int la, const HexCell& b, int lb) {
-  using Four = int32_t __attribute__((vector_size(16)));
-  const int* oa = hex_faces[hex_opposite_face[la]];
-  const int* ob = hex_faces[hex_opposite_face[lb]];
-  const Four x = {a[oa[0]], a[oa[1]], a[oa[2]], a[oa[3]]};
-  const Four y = {b[ob[0]], b[ob[1]], b[ob[2]], b[ob[3]]};
+  const Four x = hex_nodes_off_face(a, la), y = hex_nodes_off_face(b, lb);
   const Four equal = (x == y) | (x == __builtin_shufflevector(y, y, 1, 2, 3, 0)) |
                      (x == __builtin_shufflevector(y, y, 2, 3, 0, 1)) |
                      (x == __builtin_shufflevector(y, y, 3, 0, 1, 2));
@@ -104,7 +133,7 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
     std::vector<uint32_t>& count = offsets[p];
     count.assign(static_cast<size_t>(nodes), 0);
     for (int32_t h = part_begin(static_cast<int>(p)); h < part_begin(static_cast<int>(p) + 1); ++h)
-      for (int lf = 0; lf < 6; ++lf) ++count[face_lowest_node(mesh.hexes[h], lf)];
+      for (const int32_t lowest : hex_face_lowest_nodes(mesh.hexes[h])) ++count[lowest];
   });
   uint32_t running = 0;
   for (int32_t node = 0; node < nodes; ++node)
@@ -118,9 +147,12 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
   std::unique_ptr<uint32_t[]> slots(new uint32_t[running]);
   parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
     std::vector<uint32_t>& cursor = offsets[p];
-    for (int32_t h = part_begin(static_cast<int>(p)); h < part_begin(static_cast<int>(p) + 1); ++h)
+    for (int32_t h = part_begin(static_cast<int>(p)); h < part_begin(static_cast<int>(p) + 1);
+         ++h) {
+      const std::array<int32_t, 6> lowest = hex_face_lowest_nodes(mesh.hexes[h]);
       for (int lf = 0; lf < 6; ++lf)
-        slots[cursor[face_lowest_node(mesh.hexes[h], lf)]++] = static_cast<uint32_t>(h) * 6 + lf;
+        slots[cursor[lowest[lf]]++] = static_cast<uint32_t>(h) * 6 + lf;
+    }
   });
   const std::vector<uint32_t> bucket_end = std::move(offsets.back());
   offsets.clear();
@@ -130,62 +162,100 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
   // Node ranges are matched independently; their boundary and non-manifold faces are
   // concatenated in range order, which is the sequential order.
   constexpr int64_t chunk_nodes = 1 << 15;
-  constexpr int64_t prefetch_distance = 4;
+  constexpr uint32_t prefetch_slots = 24;
   const int64_t chunks = parallel_chunk_count(nodes, chunk_nodes);
   std::vector<std::vector<HexFaceSlot>> boundary(static_cast<size_t>(chunks));
   std::vector<std::vector<HexFaceSlot>> nonmanifold(static_cast<size_t>(chunks));
   std::vector<std::vector<int32_t>> doublets(static_cast<size_t>(chunks));
   parallel_chunks(threads, nodes, chunk_nodes, [&](int64_t chunk, int64_t begin, int64_t end) {
+    // A slot's other three nodes, b < d < e, as (b, d) in `low` and e in `high`.
     struct SlotKey {
-      std::array<int32_t, 3> others;
-      uint32_t slot;
-      bool matched;
+      uint64_t low;
+      uint32_t high, slot;
     };
-    std::vector<SlotKey> keys;
+    constexpr uint32_t local_keys = 64;
+    SlotKey local[local_keys];
+    std::vector<SlotKey> spill;  // buckets of more than local_keys slots
+    std::vector<HexFaceSlot>& boundary_out = boundary[chunk];
+    std::vector<HexFaceSlot>& nonmanifold_out = nonmanifold[chunk];
+    // The faces of one bucket are found in key order; in the lists they go in slot order.
+    auto slot_order = [](std::vector<HexFaceSlot>& list, size_t from) {
+      for (size_t i = from + 1; i < list.size(); ++i) {
+        const HexFaceSlot x = list[i];
+        size_t j = i;
+        for (; j > from && (x.hex < list[j - 1].hex ||
+                            (x.hex == list[j - 1].hex && x.local_face < list[j - 1].local_face));
+             --j)
+          list[j] = list[j - 1];
+        list[j] = x;
+      }
+    };
+    const uint32_t chunk_last = bucket_end[end - 1];
     for (int64_t node = begin; node < end; ++node) {
       const uint32_t first = node == 0 ? 0 : bucket_end[node - 1];
-      // The hexes of a bucket are scattered over the mesh: fetching those of a bucket a few
-      // nodes ahead hides most of the cache misses.
-      if (node + prefetch_distance < end)
-        for (uint32_t k = bucket_end[node + prefetch_distance - 1];
-             k < bucket_end[node + prefetch_distance]; ++k) {
-          __builtin_prefetch(&mesh.hexes[slots[k] / 6]);
-          if (neighbors) __builtin_prefetch(&a.hex_neighbors[slots[k] / 6], 1);
-        }
-      keys.clear();
-      for (uint32_t k = first; k < bucket_end[node]; ++k) {
-        const uint32_t s = slots[k];
-        keys.push_back({face_other_nodes(mesh.hexes[s / 6], static_cast<int>(s % 6)), s, false});
+      const uint32_t count = bucket_end[node] - first;
+      if (count == 0) continue;
+      SlotKey* keys = local;
+      if (count > local_keys) {
+        spill.resize(count);
+        keys = spill.data();
       }
-      // Buckets hold a handful of slots (6 on average), so a quadratic match beats sorting and
-      // keeps the slots, hence the faces, in ascending order.
-      for (size_t i = 0; i < keys.size(); ++i) {
-        if (keys[i].matched) continue;
+      for (uint32_t k = 0; k < count; ++k) {
+        // The hexes of a bucket are scattered over the mesh: fetching the hex of a slot a few
+        // buckets ahead hides most of the cache misses.
+        if (first + k + prefetch_slots < chunk_last) {
+          const uint32_t ahead = slots[first + k + prefetch_slots] / 6;
+          __builtin_prefetch(&mesh.hexes[ahead]);
+          if (neighbors) __builtin_prefetch(&a.hex_neighbors[ahead], 1);
+        }
+        const uint32_t s = slots[first + k];
+        const std::array<int32_t, 3> o =
+            face_other_nodes(mesh.hexes[s / 6], static_cast<int>(s % 6));
+        keys[k] = {
+            static_cast<uint64_t>(static_cast<uint32_t>(o[0])) << 32 | static_cast<uint32_t>(o[1]),
+            static_cast<uint32_t>(o[2]), s};
+      }
+      // Equal faces next to each other, each face's slots ascending: an insertion sort (buckets
+      // hold a handful of slots, 6 on average, 24 at most in a refined brick).
+      auto before = [](const SlotKey& x, const SlotKey& y) {
+        return x.low != y.low     ? x.low < y.low
+               : x.high != y.high ? x.high < y.high
+                                  : x.slot < y.slot;
+      };
+      if (count > local_keys) {
+        std::sort(keys, keys + count, before);
+      } else {
+        for (uint32_t i = 1; i < count; ++i) {
+          const SlotKey x = keys[i];
+          uint32_t j = i;
+          for (; j > 0 && before(x, keys[j - 1]); --j) keys[j] = keys[j - 1];
+          keys[j] = x;
+        }
+      }
+      const size_t boundary_from = boundary_out.size(), nonmanifold_from = nonmanifold_out.size();
+      for (uint32_t i = 0; i < count;) {
+        uint32_t j = i + 1;
+        while (j < count && keys[j].low == keys[i].low && keys[j].high == keys[i].high) ++j;
         const int32_t h0 = static_cast<int32_t>(keys[i].slot / 6);
-        int32_t h1 = -1, users = 1;
-        uint32_t second_slot = 0;
-        for (size_t j = i + 1; j < keys.size(); ++j) {
-          if (keys[j].matched || keys[j].others[0] != keys[i].others[0] ||
-              keys[j].others[1] != keys[i].others[1] || keys[j].others[2] != keys[i].others[2])
-            continue;
-          keys[j].matched = true;
-          const int32_t h = static_cast<int32_t>(keys[j].slot / 6);
-          if (neighbors) a.hex_neighbors[h][keys[j].slot % 6] = h0;
-          if (++users == 2) {
-            h1 = h;
-            second_slot = keys[j].slot;
-          }
+        const int lf0 = static_cast<int>(keys[i].slot % 6);
+        const int32_t h1 = j - i > 1 ? static_cast<int32_t>(keys[i + 1].slot / 6) : -1;
+        if (neighbors) {
+          a.hex_neighbors[h0][lf0] = h1;
+          for (uint32_t k = i + 1; k < j; ++k)
+            a.hex_neighbors[keys[k].slot / 6][keys[k].slot % 6] = h0;
         }
-        if (neighbors) a.hex_neighbors[h0][keys[i].slot % 6] = h1;
-        if (h1 >= 0 && h1 != h0 &&
-            faces_make_doublet(mesh.hexes[h0], static_cast<int>(keys[i].slot % 6), mesh.hexes[h1],
-                               static_cast<int>(second_slot % 6)))
-          doublets[chunk].push_back(h0);
-        if (users == 1)
-          boundary[chunk].push_back({h0, static_cast<int32_t>(keys[i].slot % 6)});
-        else if (users > 2)
-          nonmanifold[chunk].push_back({h0, static_cast<int32_t>(keys[i].slot % 6)});
+        if (h1 < 0) {
+          boundary_out.push_back({h0, lf0});
+        } else {
+          if (h1 != h0 && faces_make_doublet(mesh.hexes[h0], lf0, mesh.hexes[h1],
+                                             static_cast<int>(keys[i + 1].slot % 6)))
+            doublets[chunk].push_back(h0);
+          if (j - i > 2) nonmanifold_out.push_back({h0, lf0});
+        }
+        i = j;
       }
+      slot_order(boundary_out, boundary_from);
+      slot_order(nonmanifold_out, nonmanifold_from);
     }
   });
   slots.reset();

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <span>
 #if defined(__SSE2__)
@@ -55,6 +56,19 @@ inline Lanes lanes_sqrt(Lanes v) {
 #else
   return Lanes{std::sqrt(v[0]), std::sqrt(v[1])};
 #endif
+}
+
+struct LaneVector {
+  Lanes x, y, z;
+};
+
+/// Points p[0] and p[1] (x, y, z each) into lanes 0 and 1.
+inline LaneVector lanes_gather(const std::array<const double*, 2>& p) {
+  Lanes a, b;
+  std::memcpy(&a, p[0], sizeof a);
+  std::memcpy(&b, p[1], sizeof b);
+  return {__builtin_shufflevector(a, b, 0, 2), __builtin_shufflevector(a, b, 1, 3),
+          Lanes{p[0][2], p[1][2]}};
 }
 
 #include "mesh/quality_lanes.inc"
@@ -191,6 +205,25 @@ constexpr int lane_count = 4;
 
 inline Lanes lanes_sqrt(Lanes v) {
   return _mm256_sqrt_pd(v);
+}
+
+struct LaneVector {
+  Lanes x, y, z;
+};
+
+/// Points p[0..3] (x, y, z each) into lanes 0..3: their (x, y) pairs loaded whole and
+/// transposed.
+inline LaneVector lanes_gather(const std::array<const double*, 4>& p) {
+  using Two = double __attribute__((vector_size(16)));
+  Two a, b, c, d;
+  std::memcpy(&a, p[0], sizeof a);
+  std::memcpy(&b, p[1], sizeof b);
+  std::memcpy(&c, p[2], sizeof c);
+  std::memcpy(&d, p[3], sizeof d);
+  const Lanes ab = __builtin_shufflevector(a, b, 0, 1, 2, 3);  // x0 y0 x1 y1
+  const Lanes cd = __builtin_shufflevector(c, d, 0, 1, 2, 3);  // x2 y2 x3 y3
+  return {__builtin_shufflevector(ab, cd, 0, 2, 4, 6), __builtin_shufflevector(ab, cd, 1, 3, 5, 7),
+          Lanes{p[0][2], p[1][2], p[2][2], p[3][2]}};
 }
 
 #include "mesh/quality_lanes.inc"

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <string>
 
 #include "mesh/error.hpp"
@@ -73,38 +76,29 @@ std::array<int32_t, 4> face_node_set(const HexCell& c, int lf) {
 /// they share. A second shared face holds two nodes of each hex outside the first (an edge of
 /// it, or all four when it is the opposite face), so the hexes' faces opposite la and lb have a
 /// node in common; that test, 16 comparisons in four vector compares of b's four nodes rotated
-/// against a's (each hex's four taken by one shuffle of its two halves), settles almost every
-/// face (it runs once per interior face).
+/// against a's, settles almost every face (it runs once per interior face).
 using Four = int32_t __attribute__((vector_size(16)));
 
-/// The four nodes of c outside its local face lf (those of the opposite face, in some order),
-/// from its two halves lo = c[0..3] and hi = c[4..7].
-Four hex_nodes_off_face(const HexCell& c, int lf) {
-  Four lo, hi;
-  std::memcpy(&lo, c.data(), sizeof lo);
-  std::memcpy(&hi, c.data() + 4, sizeof hi);
-  switch (lf) {
-    case 0:
-      return __builtin_shufflevector(lo, hi, 1, 2, 5, 6);  // f1 {1,2,6,5}
-    case 1:
-      return __builtin_shufflevector(lo, hi, 0, 3, 4, 7);  // f0 {0,4,7,3}
-    case 2:
-      return __builtin_shufflevector(lo, hi, 2, 3, 6, 7);  // f3 {3,7,6,2}
-    case 3:
-      return __builtin_shufflevector(lo, hi, 0, 1, 4, 5);  // f2 {0,1,5,4}
-    case 4:
-      return hi;  // f5 {4,5,6,7}
-    default:
-      return lo;  // f4 {0,3,2,1}
-  }
+/// Whether some lane of a comparison's result is set.
+bool lanes_any(Four mask) {
+#if defined(__SSE2__)
+  return _mm_movemask_epi8(reinterpret_cast<__m128i>(mask)) != 0;
+#else
+  return (mask[0] | mask[1] | mask[2] | mask[3]) != 0;
+#endif
 }
 
 bool faces_make_doublet(const HexCell& a, int la, const HexCell& b, int lb) {
-  const Four x = hex_nodes_off_face(a, la), y = hex_nodes_off_face(b, lb);
+  // The four nodes of each hex off the shared face: those of its opposite face, by a table (no
+  // branch on the face: it varies from one face to the next).
+  const int* oa = hex_faces[hex_opposite_face[la]];
+  const int* ob = hex_faces[hex_opposite_face[lb]];
+  const Four x = {a[oa[0]], a[oa[1]], a[oa[2]], a[oa[3]]};
+  const Four y = {b[ob[0]], b[ob[1]], b[ob[2]], b[ob[3]]};
   const Four equal = (x == y) | (x == __builtin_shufflevector(y, y, 1, 2, 3, 0)) |
                      (x == __builtin_shufflevector(y, y, 2, 3, 0, 1)) |
                      (x == __builtin_shufflevector(y, y, 3, 0, 1, 2));
-  if ((equal[0] | equal[1] | equal[2] | equal[3]) == 0) return false;
+  if (!lanes_any(equal)) return false;
   return faces_share_another_face(a, la, b);
 }
 
@@ -132,7 +126,8 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
   parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
     std::vector<uint32_t>& count = offsets[p];
     count.assign(static_cast<size_t>(nodes), 0);
-    for (int32_t h = part_begin(static_cast<int>(p)); h < part_begin(static_cast<int>(p) + 1); ++h)
+    const int32_t last = part_begin(static_cast<int>(p) + 1);
+    for (int32_t h = part_begin(static_cast<int>(p)); h < last; ++h)
       for (const int32_t lowest : hex_face_lowest_nodes(mesh.hexes[h])) ++count[lowest];
   });
   uint32_t running = 0;
@@ -147,8 +142,8 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
   std::unique_ptr<uint32_t[]> slots(new uint32_t[running]);
   parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
     std::vector<uint32_t>& cursor = offsets[p];
-    for (int32_t h = part_begin(static_cast<int>(p)); h < part_begin(static_cast<int>(p) + 1);
-         ++h) {
+    const int32_t last = part_begin(static_cast<int>(p) + 1);
+    for (int32_t h = part_begin(static_cast<int>(p)); h < last; ++h) {
       const std::array<int32_t, 6> lowest = hex_face_lowest_nodes(mesh.hexes[h]);
       for (int lf = 0; lf < 6; ++lf)
         slots[cursor[lowest[lf]]++] = static_cast<uint32_t>(h) * 6 + lf;
@@ -175,21 +170,10 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
     };
     constexpr uint32_t local_keys = 64;
     SlotKey local[local_keys];
-    std::vector<SlotKey> spill;  // buckets of more than local_keys slots
+    std::vector<SlotKey> spill;    // buckets of more than local_keys slots
+    std::vector<char> done_flags;  // and their matched flags
     std::vector<HexFaceSlot>& boundary_out = boundary[chunk];
     std::vector<HexFaceSlot>& nonmanifold_out = nonmanifold[chunk];
-    // The faces of one bucket are found in key order; in the lists they go in slot order.
-    auto slot_order = [](std::vector<HexFaceSlot>& list, size_t from) {
-      for (size_t i = from + 1; i < list.size(); ++i) {
-        const HexFaceSlot x = list[i];
-        size_t j = i;
-        for (; j > from && (x.hex < list[j - 1].hex ||
-                            (x.hex == list[j - 1].hex && x.local_face < list[j - 1].local_face));
-             --j)
-          list[j] = list[j - 1];
-        list[j] = x;
-      }
-    };
     const uint32_t chunk_last = bucket_end[end - 1];
     for (int64_t node = begin; node < end; ++node) {
       const uint32_t first = node == 0 ? 0 : bucket_end[node - 1];
@@ -215,47 +199,44 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
             static_cast<uint64_t>(static_cast<uint32_t>(o[0])) << 32 | static_cast<uint32_t>(o[1]),
             static_cast<uint32_t>(o[2]), s};
       }
-      // Equal faces next to each other, each face's slots ascending: an insertion sort (buckets
-      // hold a handful of slots, 6 on average, 24 at most in a refined brick).
-      auto before = [](const SlotKey& x, const SlotKey& y) {
-        return x.low != y.low     ? x.low < y.low
-               : x.high != y.high ? x.high < y.high
-                                  : x.slot < y.slot;
+      // Buckets hold a handful of slots (6 on average, 24 at most in a refined brick): a
+      // quadratic match, each slot against the later ones, finds each face at its lowest slot,
+      // so the faces come out in slot order. `done` marks the slots already matched (a bitmask up
+      // to 64 slots, flags beyond).
+      uint64_t done = 0;
+      if (count > 64) done_flags.assign(count, 0);
+      auto is_done = [&](uint32_t k) {
+        return count <= 64 ? (done >> k & 1) != 0 : done_flags[k] != 0;
       };
-      if (count > local_keys) {
-        std::sort(keys, keys + count, before);
-      } else {
-        for (uint32_t i = 1; i < count; ++i) {
-          const SlotKey x = keys[i];
-          uint32_t j = i;
-          for (; j > 0 && before(x, keys[j - 1]); --j) keys[j] = keys[j - 1];
-          keys[j] = x;
+      for (uint32_t i = 0; i < count; ++i) {
+        if (is_done(i)) continue;
+        const SlotKey key = keys[i];
+        int users = 1;
+        uint32_t second = 0;
+        for (uint32_t j = i + 1; j < count; ++j) {
+          if (keys[j].low != key.low || keys[j].high != key.high || is_done(j)) continue;
+          if (count <= 64)
+            done |= uint64_t{1} << j;
+          else
+            done_flags[j] = 1;
+          if (++users == 2) second = keys[j].slot;
+          if (neighbors)
+            a.hex_neighbors[keys[j].slot / 6][keys[j].slot % 6] =
+                static_cast<int32_t>(key.slot / 6);
         }
-      }
-      const size_t boundary_from = boundary_out.size(), nonmanifold_from = nonmanifold_out.size();
-      for (uint32_t i = 0; i < count;) {
-        uint32_t j = i + 1;
-        while (j < count && keys[j].low == keys[i].low && keys[j].high == keys[i].high) ++j;
-        const int32_t h0 = static_cast<int32_t>(keys[i].slot / 6);
-        const int lf0 = static_cast<int>(keys[i].slot % 6);
-        const int32_t h1 = j - i > 1 ? static_cast<int32_t>(keys[i + 1].slot / 6) : -1;
-        if (neighbors) {
-          a.hex_neighbors[h0][lf0] = h1;
-          for (uint32_t k = i + 1; k < j; ++k)
-            a.hex_neighbors[keys[k].slot / 6][keys[k].slot % 6] = h0;
-        }
+        const int32_t h0 = static_cast<int32_t>(key.slot / 6);
+        const int lf0 = static_cast<int>(key.slot % 6);
+        const int32_t h1 = users > 1 ? static_cast<int32_t>(second / 6) : -1;
+        if (neighbors) a.hex_neighbors[h0][lf0] = h1;
         if (h1 < 0) {
           boundary_out.push_back({h0, lf0});
         } else {
-          if (h1 != h0 && faces_make_doublet(mesh.hexes[h0], lf0, mesh.hexes[h1],
-                                             static_cast<int>(keys[i + 1].slot % 6)))
+          if (h1 != h0 &&
+              faces_make_doublet(mesh.hexes[h0], lf0, mesh.hexes[h1], static_cast<int>(second % 6)))
             doublets[chunk].push_back(h0);
-          if (j - i > 2) nonmanifold_out.push_back({h0, lf0});
+          if (users > 2) nonmanifold_out.push_back({h0, lf0});
         }
-        i = j;
       }
-      slot_order(boundary_out, boundary_from);
-      slot_order(nonmanifold_out, nonmanifold_from);
     }
   });
   slots.reset();

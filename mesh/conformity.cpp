@@ -691,7 +691,11 @@ std::vector<std::string> mesh_check_defects(const MeshCheckReport& r) {
     if (count > 0) out.push_back(std::to_string(count) + " " + what);
   };
   add(r.nonmanifold_faces, "faces shared by more than two hexes");
-  add(r.non_conformal_faces, "non-conformal faces");
+  add(r.non_conformal_faces,
+      r.reference_compared
+          ? "non-conformal faces (boundary faces not on the reference's boundary surface: a gap "
+            "between hexes, or a face that left the surface)"
+          : "non-conformal faces (two sides of a gap between hexes that should share a face)");
   add(r.hanging_nodes, "hanging nodes");
   add(r.nonmanifold_boundary_edges, "boundary edges not in exactly two boundary faces");
   add(r.doublets, "doublets (hex pairs sharing two or more faces)");

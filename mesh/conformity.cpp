@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <climits>
 #include <cmath>
 #include <cstdio>
@@ -238,6 +239,55 @@ double mesh_volume(const HexMesh& mesh) {
   return volume;
 }
 
+/// Sorts `keys`, whose values are below 2^bits, by a least-significant-digit radix sort of at
+/// most 16-bit digits (a counting sort per digit, each stable): linear in the keys, a few passes.
+void radix_sort(std::vector<uint64_t>& keys, int bits) {
+  if (keys.size() < 2) return;
+  const int passes = std::max(1, (bits + 15) / 16);
+  const int digit_bits = (bits + passes - 1) / passes;
+  const uint64_t mask = (uint64_t{1} << digit_bits) - 1;
+  std::vector<uint64_t> other(keys.size());
+  std::vector<uint32_t> start(size_t{1} << digit_bits);
+  for (int pass = 0; pass < passes; ++pass) {
+    const int shift = pass * digit_bits;
+    std::fill(start.begin(), start.end(), 0);
+    for (const uint64_t k : keys) ++start[(k >> shift) & mask];
+    uint32_t running = 0;
+    for (uint32_t& s : start) {
+      const uint32_t count = s;
+      s = running;
+      running += count;
+    }
+    for (const uint64_t k : keys) other[start[(k >> shift) & mask]++] = k;
+    keys.swap(other);
+  }
+}
+
+/// mesh_bounding_box (the same corners) on up to `threads` threads: per chunk of points, combined
+/// in chunk order.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box_on_threads(const HexMesh& mesh,
+                                                                         int threads) {
+  if (mesh.points.empty()) return {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  constexpr int64_t chunk_points = 1 << 16;
+  const int64_t n = static_cast<int64_t>(mesh.points.size());
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> boxes(
+      static_cast<size_t>(parallel_chunk_count(n, chunk_points)));
+  parallel_chunks(threads, n, chunk_points, [&](int64_t chunk, int64_t begin, int64_t end) {
+    Eigen::Vector3d lo = mesh.points[begin], hi = mesh.points[begin];
+    for (int64_t i = begin; i < end; ++i) {
+      lo = lo.cwiseMin(mesh.points[i]);
+      hi = hi.cwiseMax(mesh.points[i]);
+    }
+    boxes[chunk] = {lo, hi};
+  });
+  Eigen::Vector3d lo = mesh.points[0], hi = mesh.points[0];
+  for (const auto& [chunk_lo, chunk_hi] : boxes) {
+    lo = lo.cwiseMin(chunk_lo);
+    hi = hi.cwiseMax(chunk_hi);
+  }
+  return {lo, hi};
+}
+
 /// Nodes within mesh_check_duplicate_tolerance x diagonal of a lower-id node. Points are
 /// bucketed by a coarse cell (about four points per cell, one counting sort); near pairs share a
 /// cell unless they straddle a cell wall, so only points within the tolerance of a wall also
@@ -248,7 +298,7 @@ double mesh_volume(const HexMesh& mesh) {
 int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
-  const auto [lo, hi] = mesh_bounding_box(mesh);
+  const auto [lo, hi] = mesh_bounding_box_on_threads(mesh, threads);
   const double tolerance = mesh_check_duplicate_tolerance * (hi - lo).norm();
   const double extent = (hi - lo).maxCoeff();
   const double cell =
@@ -311,13 +361,7 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
     for (int32_t i = part_begin(static_cast<int>(p)); i < part_begin(static_cast<int>(p) + 1); ++i)
       ++count[cell_of_point[i]];
   });
-  uint32_t running = 0;
-  for (int64_t c = 0; c < cells; ++c)
-    for (int p = 0; p < parts; ++p) {
-      const uint32_t count = offsets[p][c];
-      offsets[p][c] = running;
-      running += count;
-    }
+  counting_sort_starts(offsets, threads);
   // Each point with a key, its projection on a fixed direction of irrational slopes, rounded to
   // float: two points within the tolerance have keys within key_tolerance (the projection moves
   // by at most key_slopes x their distance, rounding to float by half a float ulp, at most
@@ -530,9 +574,11 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
       boundary_surface(mesh, std::move(adjacency.boundary_faces), threads);
   r.boundary_faces = static_cast<int64_t>(surface.slots.size());
   // Every boundary edge must be used by exactly two boundary faces: count the uses of each
-  // (lower node, higher node) pair over the boundary faces (sorted, linear in the boundary).
-  // Keys and areas per face on every thread; the areas summed in face order, so the total does
-  // not depend on the thread count.
+  // (lower node, higher node) pair over the boundary faces, keys of 2 x node_bits bits sorted by
+  // radix (linear in the boundary). Keys and areas per face on every thread; the areas summed in
+  // face order, so the total does not depend on the thread count.
+  const int node_bits = std::max(
+      1, static_cast<int>(std::bit_width(static_cast<uint32_t>(std::max(mesh.point_count(), 1)))));
   std::vector<uint64_t> boundary_edges(4 * surface.slots.size());
   {
     std::vector<double> areas(surface.slots.size());
@@ -541,26 +587,16 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
         const auto& n = surface.nodes[i];
         for (int k = 0; k < 4; ++k) {
           const uint32_t a = static_cast<uint32_t>(n[k]), b = static_cast<uint32_t>(n[(k + 1) % 4]);
-          boundary_edges[4 * i + k] = static_cast<uint64_t>(std::min(a, b)) << 32 | std::max(a, b);
+          boundary_edges[4 * i + k] =
+              static_cast<uint64_t>(std::min(a, b)) << node_bits | std::max(a, b);
         }
         areas[i] = quad_area(surface.quads[i]);
       }
     });
     for (double area : areas) r.boundary_area += area;
   }
-  // Sorted in two halves on two threads, then merged.
-  if (threads > 1 && boundary_edges.size() > (size_t{1} << 16)) {
-    const auto middle =
-        boundary_edges.begin() + static_cast<std::ptrdiff_t>(boundary_edges.size() / 2);
-    parallel_chunks(2, 2, 1, [&](int64_t half, int64_t, int64_t) {
-      if (half == 0)
-        std::sort(boundary_edges.begin(), middle);
-      else
-        std::sort(middle, boundary_edges.end());
-    });
-    std::inplace_merge(boundary_edges.begin(), middle, boundary_edges.end());
-  } else
-    std::sort(boundary_edges.begin(), boundary_edges.end());
+  radix_sort(boundary_edges, 64 - std::countl_zero(std::max<uint64_t>(
+                                      1, static_cast<uint64_t>(mesh.point_count()) << 32)));
   for (size_t i = 0; i < boundary_edges.size();) {
     size_t j = i;
     while (j < boundary_edges.size() && boundary_edges[j] == boundary_edges[i]) ++j;

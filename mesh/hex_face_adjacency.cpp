@@ -104,6 +104,31 @@ bool faces_make_doublet(const HexCell& a, int la, const HexCell& b, int lb) {
 
 }  // namespace
 
+uint32_t counting_sort_starts(std::vector<std::vector<uint32_t>>& counts, int threads) {
+  if (counts.empty()) return 0;
+  const int64_t buckets = static_cast<int64_t>(counts[0].size());
+  constexpr int64_t block = 1 << 16;
+  std::vector<uint32_t> block_start(static_cast<size_t>(parallel_chunk_count(buckets, block)) + 1,
+                                    0);
+  parallel_chunks(threads, buckets, block, [&](int64_t b, int64_t begin, int64_t end) {
+    uint32_t total = 0;
+    for (const std::vector<uint32_t>& part : counts)
+      for (int64_t k = begin; k < end; ++k) total += part[k];
+    block_start[b + 1] = total;
+  });
+  for (size_t b = 1; b < block_start.size(); ++b) block_start[b] += block_start[b - 1];
+  parallel_chunks(threads, buckets, block, [&](int64_t b, int64_t begin, int64_t end) {
+    uint32_t running = block_start[b];
+    for (int64_t k = begin; k < end; ++k)
+      for (std::vector<uint32_t>& part : counts) {
+        const uint32_t count = part[k];
+        part[k] = running;
+        running += count;
+      }
+  });
+  return block_start.back();
+}
+
 HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool neighbors) {
   const int32_t hexes = mesh.hex_count();
   if (hexes > hex_face_adjacency_max_hexes)
@@ -130,13 +155,7 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
     for (int32_t h = part_begin(static_cast<int>(p)); h < last; ++h)
       for (const int32_t lowest : hex_face_lowest_nodes(mesh.hexes[h])) ++count[lowest];
   });
-  uint32_t running = 0;
-  for (int32_t node = 0; node < nodes; ++node)
-    for (int p = 0; p < parts; ++p) {
-      const uint32_t count = offsets[p][node];
-      offsets[p][node] = running;
-      running += count;
-    }
+  const uint32_t running = counting_sort_starts(offsets, threads);
   // Left uninitialised: the scatter writes every entry, so its threads, not a serial zero fill,
   // are the first to touch these pages (24 bytes per hex, the largest array of the checker).
   std::unique_ptr<uint32_t[]> slots(new uint32_t[running]);

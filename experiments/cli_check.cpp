@@ -105,6 +105,10 @@ int check_run(const CliArgs& a) {
   if (report.duplicate_nodes > 0)
     out << "  note: " << report.duplicate_nodes << " duplicate nodes\n";
   if (report.unused_nodes > 0) out << "  note: " << report.unused_nodes << " unused nodes\n";
+  if (report.self_contact_faces > 0)
+    out << "  note: " << report.self_contact_faces
+        << " boundary faces touch another part of the boundary (self-contact: no node joins "
+           "them; not a defect)\n";
   const std::vector<std::string> defects = mesh_check_defects(report);
   if (defects.empty()) {
     out << "  valid: conformal, no inverted hex\n";

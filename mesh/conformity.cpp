@@ -3,15 +3,20 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <atomic>
+#include <bit>
+#include <climits>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
+#include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
 #include "mesh/hex_face_adjacency.hpp"
 #include "mesh/parallel.hpp"
@@ -103,6 +108,126 @@ bool face_lies_across_reference(const Quad& q, const QuadGrid& grid,
   return false;
 }
 
+/// Two boundary faces of one mesh that touch: every corner of `face` is a node of `other` or
+/// lies on it (within mesh_check_surface_tolerance x its diameter), they face each other
+/// (opposite normals) and `face`'s hex lies beyond `other` (see conformity.hpp). `connected`:
+/// they share a node, or a corner of one is at a corner of the other (a node split in two).
+struct FaceContact {
+  int32_t face, other;
+  bool connected;
+};
+
+/// The boundary faces that touch another part of the boundary, split into gaps (non-conformal)
+/// and self-contact, both ascending (see conformity.hpp).
+struct BoundaryContacts {
+  std::vector<int32_t> gap_faces, self_contact_faces;
+};
+
+/// The contact of boundary face i with boundary face j of `surface`, if they touch (FaceContact).
+std::optional<FaceContact> boundary_faces_touch(const HexMesh& mesh, const BoundarySurface& surface,
+                                                const QuadGrid& grid,
+                                                const std::vector<double>& tight, int32_t i,
+                                                int32_t j) {
+  const Quad& q = surface.quads[i];
+  const Quad& other = surface.quads[j];
+  const std::array<int32_t, 4>& nodes = surface.nodes[i];
+  const std::array<int32_t, 4>& other_nodes = surface.nodes[j];
+  bool connected = false;
+  for (int k = 0; k < 4; ++k) {
+    if (std::find(other_nodes.begin(), other_nodes.end(), nodes[k]) != other_nodes.end()) {
+      connected = true;
+      continue;
+    }
+    if (!grid.box_contains(j, q[k]) || !quad_within(other, q[k], tight[j])) return std::nullopt;
+    for (const Eigen::Vector3d& c : other)
+      if ((c - q[k]).norm() <= tight[j]) connected = true;
+  }
+  // Facing: the normal of i against the normal of j's patch where i's centroid projects.
+  const Eigen::Vector3d normal = quad_unit_normal(q);
+  if (normal.isZero()) return std::nullopt;
+  const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
+  const QuadProjection at = quad_closest_point(other, centroid);
+  const auto [su, sv] = quad_tangents(other, at.u, at.v);
+  Eigen::Vector3d other_normal = su.cross(sv);
+  if (other_normal.norm() > 0.0)
+    other_normal.normalize();
+  else
+    other_normal = quad_unit_normal(other);
+  if (!(normal.dot(other_normal) < 0.0)) return std::nullopt;
+  // Beyond: the centroid of the face opposite i in i's hex, on the outer side of j.
+  const HexCell& c = mesh.hexes[surface.slots[i].hex];
+  const int* opposite = hex_faces[hex_opposite_face[surface.slots[i].local_face]];
+  const Eigen::Vector3d far = (mesh.points[c[opposite[0]]] + mesh.points[c[opposite[1]]] +
+                               mesh.points[c[opposite[2]]] + mesh.points[c[opposite[3]]]) /
+                              4.0;
+  if (!((far - at.point).dot(other_normal) > tight[j])) return std::nullopt;
+  return FaceContact{i, j, connected};
+}
+
+/// Without a reference: the boundary faces that touch another part of the boundary, found from
+/// each face's first corner (the grid lists the faces within the tight tolerance of it), and
+/// grouped into contact patches (faces linked by a contact): a patch with a connected contact is
+/// a gap, the others self-contact.
+BoundaryContacts boundary_contacts(const HexMesh& mesh, const BoundarySurface& surface,
+                                   int threads) {
+  const int64_t faces = static_cast<int64_t>(surface.quads.size());
+  std::vector<double> tight(surface.quads.size());
+  for (int64_t i = 0; i < faces; ++i)
+    tight[i] = mesh_check_surface_tolerance * quad_diameter(surface.quads[i]);
+  const QuadGrid grid(surface.quads, tight);
+  constexpr int64_t chunk_faces = 1 << 12;
+  std::vector<std::vector<FaceContact>> found(
+      static_cast<size_t>(parallel_chunk_count(faces, chunk_faces)));
+  parallel_chunks(threads, faces, chunk_faces, [&](int64_t chunk, int64_t begin, int64_t end) {
+    for (int32_t i = static_cast<int32_t>(begin); i < end; ++i) {
+      // Every corner of i lies on the faces it touches, the first one too: those faces are
+      // registered in its cell. The faces around that corner pass the box test and fail at
+      // the next corner that is neither their node nor near them.
+      const Eigen::Vector3d& corner = surface.quads[i][0];
+      grid.visit_cell(corner, [&](int32_t j) {
+        if (j != i && grid.box_contains(j, corner))
+          if (const std::optional<FaceContact> contact =
+                  boundary_faces_touch(mesh, surface, grid, tight, i, j))
+            found[chunk].push_back(*contact);
+        return false;
+      });
+    }
+  });
+  // Contact patches: union-find over the faces in a contact (few: none in most meshes).
+  std::vector<int32_t> members;
+  for (const std::vector<FaceContact>& list : found)
+    for (const FaceContact& c : list) {
+      members.push_back(c.face);
+      members.push_back(c.other);
+    }
+  std::sort(members.begin(), members.end());
+  members.erase(std::unique(members.begin(), members.end()), members.end());
+  auto index_of = [&](int32_t face) {
+    return static_cast<int32_t>(std::lower_bound(members.begin(), members.end(), face) -
+                                members.begin());
+  };
+  std::vector<int32_t> parent(members.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](int32_t k) {
+    while (parent[k] != k) k = parent[k] = parent[parent[k]];
+    return k;
+  };
+  for (const std::vector<FaceContact>& list : found)
+    for (const FaceContact& c : list) {
+      const int32_t a = root(index_of(c.face)), b = root(index_of(c.other));
+      parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<char> gap(members.size(), 0);
+  for (const std::vector<FaceContact>& list : found)
+    for (const FaceContact& c : list)
+      if (c.connected) gap[root(index_of(c.face))] = 1;
+  BoundaryContacts out;
+  for (size_t k = 0; k < members.size(); ++k)
+    (gap[root(static_cast<int32_t>(k))] ? out.gap_faces : out.self_contact_faces)
+        .push_back(members[k]);
+  return out;
+}
+
 double relative_error(double value, double reference) {
   if (reference == 0.0) return value == 0.0 ? 0.0 : std::abs(value);
   return std::abs(value - reference) / std::abs(reference);
@@ -112,6 +237,55 @@ double mesh_volume(const HexMesh& mesh) {
   double volume = 0.0;
   for (int32_t h = 0; h < mesh.hex_count(); ++h) volume += hex_volume(hex_points(mesh, h));
   return volume;
+}
+
+/// Sorts `keys`, whose values are below 2^bits, by a least-significant-digit radix sort of at
+/// most 16-bit digits (a counting sort per digit, each stable): linear in the keys, a few passes.
+void radix_sort(std::vector<uint64_t>& keys, int bits) {
+  if (keys.size() < 2) return;
+  const int passes = std::max(1, (bits + 15) / 16);
+  const int digit_bits = (bits + passes - 1) / passes;
+  const uint64_t mask = (uint64_t{1} << digit_bits) - 1;
+  std::vector<uint64_t> other(keys.size());
+  std::vector<uint32_t> start(size_t{1} << digit_bits);
+  for (int pass = 0; pass < passes; ++pass) {
+    const int shift = pass * digit_bits;
+    std::fill(start.begin(), start.end(), 0);
+    for (const uint64_t k : keys) ++start[(k >> shift) & mask];
+    uint32_t running = 0;
+    for (uint32_t& s : start) {
+      const uint32_t count = s;
+      s = running;
+      running += count;
+    }
+    for (const uint64_t k : keys) other[start[(k >> shift) & mask]++] = k;
+    keys.swap(other);
+  }
+}
+
+/// mesh_bounding_box (the same corners) on up to `threads` threads: per chunk of points, combined
+/// in chunk order.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box_on_threads(const HexMesh& mesh,
+                                                                         int threads) {
+  if (mesh.points.empty()) return {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  constexpr int64_t chunk_points = 1 << 16;
+  const int64_t n = static_cast<int64_t>(mesh.points.size());
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> boxes(
+      static_cast<size_t>(parallel_chunk_count(n, chunk_points)));
+  parallel_chunks(threads, n, chunk_points, [&](int64_t chunk, int64_t begin, int64_t end) {
+    Eigen::Vector3d lo = mesh.points[begin], hi = mesh.points[begin];
+    for (int64_t i = begin; i < end; ++i) {
+      lo = lo.cwiseMin(mesh.points[i]);
+      hi = hi.cwiseMax(mesh.points[i]);
+    }
+    boxes[chunk] = {lo, hi};
+  });
+  Eigen::Vector3d lo = mesh.points[0], hi = mesh.points[0];
+  for (const auto& [chunk_lo, chunk_hi] : boxes) {
+    lo = lo.cwiseMin(chunk_lo);
+    hi = hi.cwiseMax(chunk_hi);
+  }
+  return {lo, hi};
 }
 
 /// Nodes within mesh_check_duplicate_tolerance x diagonal of a lower-id node. Points are
@@ -124,7 +298,7 @@ double mesh_volume(const HexMesh& mesh) {
 int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
-  const auto [lo, hi] = mesh_bounding_box(mesh);
+  const auto [lo, hi] = mesh_bounding_box_on_threads(mesh, threads);
   const double tolerance = mesh_check_duplicate_tolerance * (hi - lo).norm();
   const double extent = (hi - lo).maxCoeff();
   const double cell =
@@ -172,46 +346,78 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
       cell_of_point[i] = static_cast<uint32_t>(cell_of(k[0], k[1], k[2]));
     }
   });
-  std::vector<uint32_t> cell_end(static_cast<size_t>(cells), 0);  // counts, starts, then ends
-  for (int32_t i = 0; i < n; ++i) ++cell_end[cell_of_point[i]];
-  uint32_t running = 0;
-  for (uint32_t& c : cell_end) {
-    const uint32_t count = c;
-    c = running;
-    running += count;
-  }
-  std::unique_ptr<int32_t[]> sorted(new int32_t[n]);
-  for (int32_t i = 0; i < n; ++i) sorted[cell_end[cell_of_point[i]]++] = i;
+  // Counting sort by cell over `parts` contiguous point ranges at once (as in
+  // hex_face_adjacency_build): each range counts its points per cell, a prefix over (cell, range)
+  // gives each range its place in every cell, and each range scatters its points there, so a
+  // cell's points stay in ascending order for any thread count. offsets[p][c] counts, then
+  // starts, then ends; the last range's ends are the cells' ends.
+  const int parts =
+      static_cast<int>(std::clamp<int64_t>(threads, 1, std::clamp<int64_t>(n / 65536, 1, 4)));
+  auto part_begin = [&](int p) { return static_cast<int32_t>(int64_t{n} * p / parts); };
+  std::vector<std::vector<uint32_t>> offsets(static_cast<size_t>(parts));
+  parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
+    std::vector<uint32_t>& count = offsets[p];
+    count.assign(static_cast<size_t>(cells), 0);
+    for (int32_t i = part_begin(static_cast<int>(p)); i < part_begin(static_cast<int>(p) + 1); ++i)
+      ++count[cell_of_point[i]];
+  });
+  counting_sort_starts(offsets, threads);
+  // Each point with a key, its projection on a fixed direction of irrational slopes, rounded to
+  // float: two points within the tolerance have keys within key_tolerance (the projection moves
+  // by at most key_slopes x their distance, rounding to float by half a float ulp, at most
+  // 2^-24 x key_slopes x extent, each), so pairs are compared on their keys, next to each other in
+  // the cell, and only pairs with close keys read both points (scattered over the mesh). Structured
+  // grids, whose points share coordinates, have no two points with the same key in a cell.
+  const Eigen::Vector3d slopes(1.0, 0.7548776662, 0.5698402910);  // 1, 1/phi_3, 1/phi_3^2
+  const double key_slopes = slopes.sum();
+  const double key_tolerance =
+      (key_slopes * tolerance + std::ldexp(key_slopes * (hi - lo).maxCoeff(), -23)) * (1 + 1e-9);
+  auto key_of = [&](const Eigen::Vector3d& p) {
+    const double key = (p - lo).dot(slopes);
+    // NaN sorts last (as +infinity), so a sort by key is strict and no NaN pair is swept.
+    return std::isnan(key) ? std::numeric_limits<float>::infinity() : static_cast<float>(key);
+  };
+  struct KeyedPoint {
+    float key;
+    int32_t point;
+  };
+  std::unique_ptr<KeyedPoint[]> sorted(new KeyedPoint[n]);
+  parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
+    std::vector<uint32_t>& cursor = offsets[p];
+    for (int32_t i = part_begin(static_cast<int>(p)); i < part_begin(static_cast<int>(p) + 1); ++i)
+      sorted[cursor[cell_of_point[i]]++] = {key_of(mesh.points[i]), i};
+  });
+  const std::vector<uint32_t> cell_end = std::move(offsets.back());
+  offsets.clear();
   auto cell_begin = [&](int64_t c) { return c == 0 ? uint32_t{0} : cell_end[c - 1]; };
 
   // Pairs are compared per chunk of cells, then per chunk of points near a wall, on every thread;
   // a close pair marks its higher node (atomically: two chunks may mark the same node).
   std::vector<char> duplicate(n, 0);
-  auto compare = [&](int32_t i, int32_t j) {
-    if (i != j && (mesh.points[i] - mesh.points[j]).norm() <= tolerance)
-      std::atomic_ref<char>(duplicate[std::max(i, j)]).store(1, std::memory_order_relaxed);
+  auto compare = [&](const KeyedPoint& a, const KeyedPoint& b) {
+    if (a.point != b.point && std::abs(double{a.key} - double{b.key}) <= key_tolerance &&
+        (mesh.points[a.point] - mesh.points[b.point]).norm() <= tolerance)
+      std::atomic_ref<char>(duplicate[std::max(a.point, b.point)])
+          .store(1, std::memory_order_relaxed);
   };
-  // A crowded cell (a refined region is far denser than the bounding box's mean) is sorted by x
-  // and swept: only pairs within the tolerance in x are compared, so it costs k log k, not k^2.
+  // A crowded cell (a refined region is far denser than the bounding box's mean) is sorted by key
+  // and swept: only pairs within the key tolerance are compared, so it costs k log k, not k^2.
   parallel_chunks(threads, cells, chunk_points, [&](int64_t, int64_t begin, int64_t end) {
     for (int64_t c = begin; c < end; ++c) {
-      int32_t* first = sorted.get() + cell_begin(c);
-      int32_t* last = sorted.get() + cell_end[c];
+      KeyedPoint* first = sorted.get() + cell_begin(c);
+      KeyedPoint* last = sorted.get() + cell_end[c];
       if (last - first <= 16) {
-        for (int32_t* a = first; a < last; ++a)
-          for (int32_t* b = a + 1; b < last; ++b) compare(*a, *b);
+        for (KeyedPoint* a = first; a < last; ++a)
+          for (KeyedPoint* b = a + 1; b < last; ++b) compare(*a, *b);
         continue;
       }
-      // NaN sorts last (as +infinity), so the order is strict and no NaN pair is swept.
-      auto key = [&](int32_t i) {
-        const double x = mesh.points[i].x();
-        return std::isnan(x) ? std::numeric_limits<double>::infinity() : x;
-      };
-      std::sort(first, last, [&](int32_t i, int32_t j) {
-        return key(i) < key(j) || (key(i) == key(j) && i < j);
+      std::sort(first, last, [](const KeyedPoint& x, const KeyedPoint& y) {
+        return x.key < y.key || (x.key == y.key && x.point < y.point);
       });
-      for (int32_t* a = first; a < last; ++a)
-        for (int32_t* b = a + 1; b < last && key(*b) - key(*a) <= tolerance; ++b) compare(*a, *b);
+      for (KeyedPoint* a = first; a < last; ++a)
+        for (KeyedPoint* b = a + 1; b < last && double{b->key} - double{a->key} <= key_tolerance;
+             ++b)
+          compare(*a, *b);
     }
   });
   parallel_chunks(threads, static_cast<int64_t>(near_wall.size()), 1,
@@ -220,17 +426,58 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
                       int64_t k[3];
                       int low[3], high[3];
                       point_cell(mesh.points[i], k, low, high);
+                      const KeyedPoint self = {key_of(mesh.points[i]), i};
                       for (int dz = low[2]; dz <= high[2]; ++dz)
                         for (int dy = low[1]; dy <= high[1]; ++dy)
                           for (int dx = low[0]; dx <= high[0]; ++dx) {
                             if (dx == 0 && dy == 0 && dz == 0) continue;
                             const int64_t c = cell_of(k[0] + dx, k[1] + dy, k[2] + dz);
                             for (uint32_t b = cell_begin(c); b < cell_end[c]; ++b)
-                              compare(i, sorted[b]);
+                              compare(self, sorted[b]);
                           }
                     }
                   });
   return std::count(duplicate.begin(), duplicate.end(), 1);
+}
+
+/// The message mesh_validate_ids gives for the lowest of hexes [begin, end) whose node ids are
+/// out of range or repeated, if any.
+std::optional<std::string> hexes_bad_ids(const HexMesh& mesh, const std::string& what,
+                                         int64_t begin, int64_t end) {
+  using Four = int32_t __attribute__((vector_size(16)));
+  const int64_t n = static_cast<int64_t>(mesh.points.size());
+  // Ids are int32 and n at most 2^31: an id is in range when 0 <= id < n.
+  const Four limit = Four{} + static_cast<int32_t>(std::min<int64_t>(n, INT32_MAX));
+  const bool all_fit = n <= INT32_MAX;
+  for (int64_t h = begin; h < end; ++h) {
+    const HexCell& c = mesh.hexes[h];
+    // The range and the 28 pairs in eight vector compares of the two halves and their
+    // rotations; the loop below only names the defect.
+    Four lo, hi;
+    std::memcpy(&lo, c.data(), sizeof lo);
+    std::memcpy(&hi, c.data() + 4, sizeof hi);
+    const Four zero = {};
+    Four bad = (lo < zero) | (hi < zero);
+    if (all_fit) bad |= (lo >= limit) | (hi >= limit);
+    bad |= (lo == __builtin_shufflevector(lo, lo, 1, 2, 3, 0)) |
+           (lo == __builtin_shufflevector(lo, lo, 2, 3, 0, 1)) |
+           (hi == __builtin_shufflevector(hi, hi, 1, 2, 3, 0)) |
+           (hi == __builtin_shufflevector(hi, hi, 2, 3, 0, 1)) | (lo == hi) |
+           (lo == __builtin_shufflevector(hi, hi, 1, 2, 3, 0)) |
+           (lo == __builtin_shufflevector(hi, hi, 2, 3, 0, 1)) |
+           (lo == __builtin_shufflevector(hi, hi, 3, 0, 1, 2));
+    if ((bad[0] | bad[1] | bad[2] | bad[3]) == 0) continue;
+    for (int i = 0; i < 8; ++i) {
+      if (c[i] < 0 || c[i] >= n)
+        return what + ": hex " + std::to_string(h) + " refers to node " + std::to_string(c[i]) +
+               ", expected 0.." + std::to_string(n - 1);
+      for (int j = 0; j < i; ++j)
+        if (c[j] == c[i])
+          return what + ": hex " + std::to_string(h) + " repeats node " + std::to_string(c[i]) +
+                 " (degenerate hex)";
+    }
+  }
+  return std::nullopt;
 }
 
 /// Bin of scaled_jacobian_histogram.
@@ -242,18 +489,57 @@ int scaled_jacobian_bin(double v) {
 }  // namespace
 
 MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int threads) {
-  mesh_validate_ids(mesh, "mesh", threads);
-  if (reference) mesh_validate_ids(*reference, "reference mesh");
   MeshCheckReport r;
   r.hexes = mesh.hex_count();
   r.nodes = mesh.point_count();
-  // Unused and duplicate nodes first: their work arrays are gone before the faces are matched.
-  {
-    std::vector<char> used(mesh.points.size(), 0);
-    for (const HexCell& c : mesh.hexes)
-      for (int32_t v : c) used[v] = 1;
-    r.unused_nodes = std::count(used.begin(), used.end(), 0);
-  }
+
+  // One pass over the hexes: their ids checked (as mesh_validate_ids does, the lowest bad hex
+  // named), the nodes they use marked, and their quality and volume measured. Per fixed chunk of
+  // hexes, so the sums do not depend on the thread count.
+  struct ChunkSums {
+    double scaled_jacobian_sum = 0.0, volume = 0.0, min_scaled_jacobian = 1.0;
+    double max_edge_ratio = 1.0;
+    int64_t inverted = 0;
+    std::array<int64_t, 20> histogram{};
+    std::vector<int32_t> defects;  // ascending, at most the limit per kind
+    std::string bad_ids;           // the message for the chunk's lowest hex with bad ids
+  };
+  constexpr int64_t chunk_hexes = 1 << 14;
+  std::vector<ChunkSums> sums(static_cast<size_t>(parallel_chunk_count(r.hexes, chunk_hexes)));
+  std::vector<char> used(mesh.points.size(), 0);
+  parallel_chunks(threads, r.hexes, chunk_hexes, [&](int64_t chunk, int64_t begin, int64_t end) {
+    ChunkSums& s = sums[chunk];
+    if (const std::optional<std::string> bad = hexes_bad_ids(mesh, "mesh", begin, end)) {
+      s.bad_ids = *bad;
+      return;
+    }
+    for (int64_t h = begin; h < end; ++h)
+      for (int32_t v : mesh.hexes[h])
+        std::atomic_ref<char>(used[v]).store(1, std::memory_order_relaxed);
+    std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin)),
+        volumes(static_cast<size_t>(end - begin)), edge_ratios(static_cast<size_t>(end - begin));
+    mesh_hex_measures(mesh, static_cast<int32_t>(begin), scaled_jacobians, volumes, edge_ratios);
+    for (int32_t h = static_cast<int32_t>(begin); h < end; ++h) {
+      const double sj = scaled_jacobians[h - begin];
+      s.scaled_jacobian_sum += sj;
+      s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
+      s.volume += volumes[h - begin];
+      s.max_edge_ratio = std::max(s.max_edge_ratio, edge_ratios[h - begin]);
+      ++s.histogram[scaled_jacobian_bin(sj)];
+      if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
+        s.defects.push_back(h);
+    }
+  });
+  for (const ChunkSums& s : sums)
+    if (!s.bad_ids.empty()) throw InputError(s.bad_ids);
+  for (const HexAttribute& a : mesh.attributes)  // as mesh_validate_ids, after the hexes
+    if (a.values.size() != mesh.hexes.size())
+      throw InputError("mesh: attribute '" + a.name + "' has " + std::to_string(a.values.size()) +
+                       " values for " + std::to_string(mesh.hexes.size()) + " hexes");
+  if (reference) mesh_validate_ids(*reference, "reference mesh", threads);
+  r.unused_nodes = std::count(used.begin(), used.end(), 0);
+  used = {};
+
   r.duplicate_nodes = count_duplicate_nodes(mesh, threads);
   // Doublets come from the matching itself: no neighbour array (24 bytes per hex) is built.
   HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, threads, false);
@@ -268,32 +554,6 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
                  adjacency.doublets.begin() +
                      std::min(adjacency.doublets.size(), mesh_check_defect_hex_limit));
 
-  // Quality and volume, per fixed chunk of hexes so the sums do not depend on the thread count.
-  struct ChunkSums {
-    double scaled_jacobian_sum = 0.0, volume = 0.0, min_scaled_jacobian = 1.0;
-    double max_edge_ratio = 1.0;
-    int64_t inverted = 0;
-    std::array<int64_t, 20> histogram{};
-    std::vector<int32_t> defects;  // ascending, at most the limit per kind
-  };
-  constexpr int64_t chunk_hexes = 1 << 14;
-  std::vector<ChunkSums> sums(static_cast<size_t>(parallel_chunk_count(r.hexes, chunk_hexes)));
-  parallel_chunks(threads, r.hexes, chunk_hexes, [&](int64_t chunk, int64_t begin, int64_t end) {
-    ChunkSums& s = sums[chunk];
-    std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin)),
-        volumes(static_cast<size_t>(end - begin));
-    mesh_scaled_jacobians_and_volumes(mesh, static_cast<int32_t>(begin), scaled_jacobians, volumes);
-    for (int32_t h = static_cast<int32_t>(begin); h < end; ++h) {
-      const double sj = scaled_jacobians[h - begin];
-      s.scaled_jacobian_sum += sj;
-      s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
-      s.volume += volumes[h - begin];
-      s.max_edge_ratio = std::max(s.max_edge_ratio, hex_edge_ratio(hex_points(mesh, h)));
-      ++s.histogram[scaled_jacobian_bin(sj)];
-      if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
-        s.defects.push_back(h);
-    }
-  });
   double sum_scaled_jacobian = 0.0;
   r.scaled_jacobian_histogram.assign(20, 0);
   for (const ChunkSums& s : sums) {
@@ -314,9 +574,11 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
       boundary_surface(mesh, std::move(adjacency.boundary_faces), threads);
   r.boundary_faces = static_cast<int64_t>(surface.slots.size());
   // Every boundary edge must be used by exactly two boundary faces: count the uses of each
-  // (lower node, higher node) pair over the boundary faces (sorted, linear in the boundary).
-  // Keys and areas per face on every thread; the areas summed in face order, so the total does
-  // not depend on the thread count.
+  // (lower node, higher node) pair over the boundary faces, keys of 2 x node_bits bits sorted by
+  // radix (linear in the boundary). Keys and areas per face on every thread; the areas summed in
+  // face order, so the total does not depend on the thread count.
+  const int node_bits = std::max(
+      1, static_cast<int>(std::bit_width(static_cast<uint32_t>(std::max(mesh.point_count(), 1)))));
   std::vector<uint64_t> boundary_edges(4 * surface.slots.size());
   {
     std::vector<double> areas(surface.slots.size());
@@ -325,26 +587,16 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
         const auto& n = surface.nodes[i];
         for (int k = 0; k < 4; ++k) {
           const uint32_t a = static_cast<uint32_t>(n[k]), b = static_cast<uint32_t>(n[(k + 1) % 4]);
-          boundary_edges[4 * i + k] = static_cast<uint64_t>(std::min(a, b)) << 32 | std::max(a, b);
+          boundary_edges[4 * i + k] =
+              static_cast<uint64_t>(std::min(a, b)) << node_bits | std::max(a, b);
         }
         areas[i] = quad_area(surface.quads[i]);
       }
     });
     for (double area : areas) r.boundary_area += area;
   }
-  // Sorted in two halves on two threads, then merged.
-  if (threads > 1 && boundary_edges.size() > (size_t{1} << 16)) {
-    const auto middle =
-        boundary_edges.begin() + static_cast<std::ptrdiff_t>(boundary_edges.size() / 2);
-    parallel_chunks(2, 2, 1, [&](int64_t half, int64_t, int64_t) {
-      if (half == 0)
-        std::sort(boundary_edges.begin(), middle);
-      else
-        std::sort(middle, boundary_edges.end());
-    });
-    std::inplace_merge(boundary_edges.begin(), middle, boundary_edges.end());
-  } else
-    std::sort(boundary_edges.begin(), boundary_edges.end());
+  radix_sort(boundary_edges, 64 - std::countl_zero(std::max<uint64_t>(
+                                      1, static_cast<uint64_t>(mesh.point_count()) << 32)));
   for (size_t i = 0; i < boundary_edges.size();) {
     size_t j = i;
     while (j < boundary_edges.size() && boundary_edges[j] == boundary_edges[i]) ++j;
@@ -383,12 +635,9 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
                            (r.volume_relative_error <= mesh_check_geometry_tolerance &&
                             r.boundary_area_relative_error <= mesh_check_geometry_tolerance);
   } else {
-    const QuadGrid grid(surface.quads, surface.tolerances);
-    non_conformal = boundary_faces_where(threads, surface, [&](int32_t i) {
-      const Quad& q = surface.quads[i];
-      const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
-      return grid.find(centroid, [&](int32_t j) { return j != i; });
-    });
+    const BoundaryContacts contacts = boundary_contacts(mesh, surface, threads);
+    non_conformal = contacts.gap_faces;
+    r.self_contact_faces = static_cast<int64_t>(contacts.self_contact_faces.size());
   }
   r.non_conformal_faces = static_cast<int64_t>(non_conformal.size());
   for (int32_t i : non_conformal) defects.push_back(surface.slots[i].hex);
@@ -446,6 +695,7 @@ void to_json(nlohmann::json& j, const MeshCheckReport& r) {
   j["duplicate_nodes"] = r.duplicate_nodes;
   j["unused_nodes"] = r.unused_nodes;
   j["boundary_faces"] = r.boundary_faces;
+  j["self_contact_faces"] = r.self_contact_faces;
   j["min_scaled_jacobian"] = r.min_scaled_jacobian;
   j["mean_scaled_jacobian"] = r.mean_scaled_jacobian;
   j["max_edge_ratio"] = r.max_edge_ratio;
@@ -477,7 +727,11 @@ std::vector<std::string> mesh_check_defects(const MeshCheckReport& r) {
     if (count > 0) out.push_back(std::to_string(count) + " " + what);
   };
   add(r.nonmanifold_faces, "faces shared by more than two hexes");
-  add(r.non_conformal_faces, "non-conformal faces");
+  add(r.non_conformal_faces,
+      r.reference_compared
+          ? "non-conformal faces (boundary faces not on the reference's boundary surface: a gap "
+            "between hexes, or a face that left the surface)"
+          : "non-conformal faces (two sides of a gap between hexes that should share a face)");
   add(r.hanging_nodes, "hanging nodes");
   add(r.nonmanifold_boundary_edges, "boundary edges not in exactly two boundary faces");
   add(r.doublets, "doublets (hex pairs sharing two or more faces)");

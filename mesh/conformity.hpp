@@ -19,14 +19,46 @@
 ///     has its corners on the surface too, but stands across it) and its centroid is within
 ///     mesh_check_across_chord x its diameter of one of those faces (the sag of a chord over a
 ///     bend of at most the smoothing's feature angle).
-///   * Without a reference: a boundary face whose centroid lies on another boundary face of the
-///     same mesh (the two coincident sides of a gap). A gap that does not leave coincident faces
-///     (e.g. one hex moved away from its neighbour) cannot be told from true boundary without a
-///     reference and is not detected.
-///   "Lies on a face" = distance to the face's bilinear patch <= mesh_check_surface_tolerance
-///   times the face's longer diagonal, plus the face's warp (out-of-plane spread of its corners):
-///   on a warped face a centroid of patch points, or a node a template placed by averaging, is off
-///   the patch by up to the warp, and must not be mistaken for a gap.
+///   * Without a reference: a boundary face that, with another boundary face of the same mesh,
+///     forms the two sides of a gap. Two boundary faces A and B touch when
+///       (1) every corner of A is a node of B or lies on B (within
+///           mesh_check_surface_tolerance x B's longer diagonal: no warp term, see below),
+///       (2) they face each other: A's normal and B's patch normal where A's centroid projects
+///           have a negative dot product, and
+///       (3) A's hex lies beyond B: the centroid of the face opposite A in A's hex is on B's
+///           outer side (farther than the tolerance along B's normal there).
+///     Two neighbouring faces of a valid surface share an edge and their normals point the same
+///     way, so (2) never holds for them; where the surface folds back on itself (a sharp edge,
+///     a thin wedge) the normals oppose, but the hex between them lies on B's inner side, so (3)
+///     fails; and (1) asks every corner to lie within 1e-6 of B's size of B, so a V-notch, whose
+///     two faces share the notch's edge and face each other, counts only once it has closed to
+///     that (a crack). Faces that touch
+///     are linked; the linked groups are contact patches. A patch is a gap (its faces are
+///     non-conformal) when, in some touching pair, the faces share a node or a corner of one is
+///     at a corner of the other (a node split in two): the T-junction pocket of a hex split 1-8
+///     beside an unsplit one (the big face shares its corners with the small faces), a crack
+///     whose nodes were duplicated. Otherwise it is self-contact (self_contact_faces): two parts
+///     of the boundary touching with no node between them, which is what a contact of two bodies
+///     or of a part with itself looks like.
+///     Choice: self-contact does not make a mesh invalid. Every hex face is matched or on the
+///     boundary, so the hexes are conformal; the contact is a property of the domain (a mesher's
+///     output of touching geometry), which a refinement keeps (it subdivides the boundary faces,
+///     and its output is checked against the input). It is reported under its own count, and
+///     `hexrefine check` names it. What it cannot be told from: a gap whose two sides share no
+///     node and no corner position (two meshes laid against each other) is self-contact here.
+///     The tolerance has no warp term (the former test accepted a centroid within the warp of
+///     another face, and on a strongly warped face that band swallowed the centroid of the
+///     neighbour across an edge: ecr_dragon.mesh hex 11999, ecr_cap.mesh): a gap's sides
+///     coincide node for node (split nodes) or its hanging nodes lie on the big face's patch
+///     (where a trilinear map or a slide on the patch puts them). A gap that leaves neither
+///     (one hex moved away from its neighbour; a T-junction whose hanging nodes are off the
+///     big face by more than the tolerance) cannot be told from true boundary without a
+///     reference and is not detected: the checks of a refinement run against its input.
+///   "Lies on a face" (with a reference; hanging nodes) = distance to the face's bilinear patch
+///   <= mesh_check_surface_tolerance times the face's longer diagonal, plus the face's warp
+///   (out-of-plane spread of its corners): on a warped face a centroid of patch points, or a node
+///   a template placed on a child's patch in a later pass, is off the input's patch by up to the
+///   warp, and must not be mistaken for a gap.
 /// - hanging node (T-junction): a node of a non-conformal face that lies on another non-conformal
 ///   face B, is not one of B's nodes, and is farther than the tolerance from each of B's corners
 ///   (a different node at a corner's position is a duplicate node, not a hanging node). Each node
@@ -37,8 +69,11 @@
 /// - inverted hex: hex_scaled_jacobian <= 0 (inverted or degenerate).
 /// - duplicate node: a node within 1e-12 x (bounding-box diagonal) of a node with a lower id.
 /// - unused node: a node no hex refers to.
+/// - self-contact face: see "Without a reference" above (not examined with a reference, whose
+///   boundary the output's is compared with instead).
 /// conformal = no non-manifold faces, no non-conformal faces, no hanging nodes, no non-manifold
-/// boundary edges and no doublets.
+/// boundary edges and no doublets. Duplicate nodes, unused nodes and self-contact are reported,
+/// and make no mesh invalid.
 ///
 /// Reference comparison: total volume (sum of hex_volume) and boundary area (sum of the bilinear
 /// patch areas of the boundary faces) are compared with the reference's. If every boundary quad of
@@ -82,6 +117,9 @@ struct MeshCheckReport {
   int64_t duplicate_nodes = 0;
   int64_t unused_nodes = 0;
   int64_t boundary_faces = 0;
+  /// Boundary faces touching another part of the boundary with no node between them (without a
+  /// reference only; not a defect).
+  int64_t self_contact_faces = 0;
   /// Over all hexes; 1 for an empty mesh.
   double min_scaled_jacobian = 1.0, mean_scaled_jacobian = 1.0;
   /// Largest hex_edge_ratio over all hexes (longest over shortest edge; 1 for an empty mesh):

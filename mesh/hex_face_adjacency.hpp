@@ -43,6 +43,13 @@ struct HexFaceAdjacency {
   std::vector<int32_t> doublets;
 };
 
+/// The prefix of a counting sort over parts: counts[p][k], how many items part p puts in bucket
+/// k (every part the same number of buckets), becomes where part p's items of bucket k start
+/// when the buckets follow each other in order and, within a bucket, the parts do; returns the
+/// total. On up to `threads` threads (block totals, their prefix, then each block); the result
+/// is the same for every thread count. Precondition: the total fits 32 bits.
+uint32_t counting_sort_starts(std::vector<std::vector<uint32_t>>& counts, int threads);
+
 /// Most hexes hex_face_adjacency_build accepts: its slot ids h * 6 + lf are 32-bit.
 inline constexpr int64_t hex_face_adjacency_max_hexes = (int64_t{1} << 32) / 6 - 1;
 

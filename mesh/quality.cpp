@@ -3,9 +3,14 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <span>
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
 #endif
 
 #include "mesh/hex_convention.hpp"
@@ -29,16 +34,23 @@ Eigen::Matrix3d centre_jacobian(const std::array<Eigen::Vector3d, 12>& edges) {
   return a / 4.0;
 }
 
-/// Two doubles operated on together (one SSE2 register where there is one; GCC and Clang vector
-/// extension). Each lane does the IEEE operations of Eigen's 3x3 determinant and vector norm in
-/// their order, so the values are bit for bit those of the matrix formulation
-/// (tests/mesh/test_quality.cpp compares): the scaled Jacobian of two hexes costs about what one
-/// did, its 15 square roots and 9 divisions being the bulk and packed ones taking the time of
-/// one. One hex alone fills both lanes with itself.
+/// The scaled-Jacobian kernel works on several hexes at once, one per lane of a vector of doubles
+/// (GCC and Clang vector extension): two in an SSE2 register, the scalar functions' width and
+/// every x86-64 machine's; four in an AVX2 register for the mesh-wide passes where the machine
+/// has it (checked at run time). Each lane does the IEEE operations of Eigen's 3x3 determinant
+/// and vector norm in their order (no fused multiply-add: AVX2 alone does not enable it), so the
+/// values are bit for bit those of the matrix formulation at either width
+/// (tests/mesh/test_quality.cpp and test_quality_lanes.cpp compare): its 15 square roots and 9
+/// divisions are the bulk of the cost, and a packed one takes about the time of one. One hex
+/// alone fills every lane with itself. mesh/quality_lanes.inc holds the kernel, included once per
+/// width.
+namespace lanes2 {
+
 using Lanes = double __attribute__((vector_size(16)));
 using LaneMask = int64_t __attribute__((vector_size(16)));  ///< what comparing Lanes gives
+constexpr int lane_count = 2;
 
-Lanes lanes_sqrt(Lanes v) {
+inline Lanes lanes_sqrt(Lanes v) {
 #if defined(__SSE2__)
   return _mm_sqrt_pd(v);
 #else
@@ -46,102 +58,27 @@ Lanes lanes_sqrt(Lanes v) {
 #endif
 }
 
-/// Lane by lane: a where `take_a`, else b.
-Lanes lanes_select(LaneMask take_a, Lanes a, Lanes b) {
-  return (Lanes)((take_a & (LaneMask)a) | (~take_a & (LaneMask)b));
-}
-
-/// std::min(a, b) lane by lane (b only where b < a: a NaN in a stays).
-Lanes lanes_min(Lanes a, Lanes b) {
-  return lanes_select(b < a, b, a);
-}
-
 struct LaneVector {
   Lanes x, y, z;
 };
 
-LaneVector lanes_difference(const LaneVector& a, const LaneVector& b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
+/// Points p[0] and p[1] (x, y, z each) into lanes 0 and 1.
+inline LaneVector lanes_gather(const std::array<const double*, 2>& p) {
+  Lanes a, b;
+  std::memcpy(&a, p[0], sizeof a);
+  std::memcpy(&b, p[1], sizeof b);
+  return {__builtin_shufflevector(a, b, 0, 2), __builtin_shufflevector(a, b, 1, 3),
+          Lanes{p[0][2], p[1][2]}};
 }
 
-/// Eigen's Vector3d::norm: sqrt((x x + y y) + z z).
-Lanes lanes_length(const LaneVector& v) {
-  return lanes_sqrt((v.x * v.x + v.y * v.y) + v.z * v.z);
-}
+#include "mesh/quality_lanes.inc"
 
-/// det of the matrix with columns a, b, c, as Eigen's 3x3 determinant (cofactors of the first
-/// row, in its order).
-Lanes lanes_determinant(const LaneVector& a, const LaneVector& b, const LaneVector& c) {
-  return a.x * (b.y * c.z - c.y * b.z) - b.x * (a.y * c.z - c.y * a.z) +
-         c.x * (a.y * b.z - b.y * a.z);
-}
+}  // namespace lanes2
 
-/// One scaled-Jacobian sample lane by lane: clamp(det / (l0 l1 l2), -1, 1) for the columns a, b,
-/// c of lengths l0, l1, l2; 0 where l0 l1 l2 is not above the smallest normal double.
-Lanes lanes_scaled_determinant(const LaneVector& a, const LaneVector& b, const LaneVector& c,
-                               Lanes length0, Lanes length1, Lanes length2) {
-  const Lanes lengths = length0 * length1 * length2;
-  const Lanes low = {-1.0, -1.0}, high = {1.0, 1.0}, zero = {0.0, 0.0};
-  const Lanes tiny = {std::numeric_limits<double>::min(), std::numeric_limits<double>::min()};
-  const Lanes q = lanes_determinant(a, b, c) / lengths;
-  const Lanes clamped = lanes_select(q < low, low, lanes_select(high < q, high, q));
-  return lanes_select(lengths > tiny, clamped, zero);
-}
-
-/// The nine scaled-Jacobian samples of two hexes (lane k: the hex whose corners are lane k of
-/// `p`), as hex_scaled_jacobian_samples orders them: corners 0..7, then the centre.
-void lanes_scaled_jacobian_samples(const std::array<LaneVector, 8>& p, std::array<Lanes, 9>& out) {
-  std::array<LaneVector, 12> edges;
-  std::array<Lanes, 12> lengths;
-  for (int e = 0; e < 12; ++e) {
-    edges[e] = lanes_difference(p[hex_edges[e][1]], p[hex_edges[e][0]]);
-    lengths[e] = lanes_length(edges[e]);
-  }
-  for (int v = 0; v < 8; ++v) {
-    const int* e = hex_vertex_edges[v];
-    out[v] = lanes_scaled_determinant(edges[e[0]], edges[e[1]], edges[e[2]], lengths[e[0]],
-                                      lengths[e[1]], lengths[e[2]]);
-  }
-  // The centre column sums its axis' edges onto zero, as Eigen's accumulation did (0 + -0 = +0).
-  std::array<LaneVector, 3> centre;
-  for (int k = 0; k < 3; ++k) {
-    LaneVector sum = {Lanes{0.0, 0.0}, Lanes{0.0, 0.0}, Lanes{0.0, 0.0}};
-    for (int e : hex_axis_edges[k])
-      sum = {sum.x + edges[e].x, sum.y + edges[e].y, sum.z + edges[e].z};
-    const Lanes four = {4.0, 4.0};
-    centre[k] = {sum.x / four, sum.y / four, sum.z / four};
-  }
-  out[8] = lanes_scaled_determinant(centre[0], centre[1], centre[2], lanes_length(centre[0]),
-                                    lanes_length(centre[1]), lanes_length(centre[2]));
-}
-
-/// hex_scaled_jacobian's minimum from its samples: the centre, then the corners in order.
-Lanes lanes_scaled_jacobian(const std::array<LaneVector, 8>& p) {
-  std::array<Lanes, 9> samples;
-  lanes_scaled_jacobian_samples(p, samples);
-  Lanes best = samples[8];
-  for (int v = 0; v < 8; ++v) best = lanes_min(best, samples[v]);
-  return best;
-}
-
-/// hex_volume lane by lane: Grandy's three triple products, each a.dot(b.cross(c)) in Eigen's
-/// order of operations.
-Lanes lanes_volume(const std::array<LaneVector, 8>& p) {
-  auto d = [&](int a, int b) { return lanes_difference(p[a], p[b]); };
-  auto sum = [](const LaneVector& a, const LaneVector& b) {
-    return LaneVector{a.x + b.x, a.y + b.y, a.z + b.z};
-  };
-  auto triple = [](const LaneVector& a, const LaneVector& b, const LaneVector& c) {
-    const LaneVector cross = {b.y * c.z - b.z * c.y, b.z * c.x - b.x * c.z, b.x * c.y - b.y * c.x};
-    return (a.x * cross.x + a.y * cross.y) + a.z * cross.z;
-  };
-  const LaneVector d70 = d(7, 0), d61 = d(6, 1), d63 = d(6, 3), d20 = d(2, 0), d50 = d(5, 0),
-                   d64 = d(6, 4);
-  const Lanes twelve = {12.0, 12.0};
-  return (triple(sum(d61, d70), d63, d20) + triple(d70, sum(d63, d50), d64) +
-          triple(d61, d50, sum(d64, d20))) /
-         twelve;
-}
+using lanes2::Lanes;
+using lanes2::lanes_scaled_jacobian;
+using lanes2::lanes_scaled_jacobian_samples;
+using lanes2::LaneVector;
 
 /// Corners of hex a in lane 0 and of hex b in lane 1.
 std::array<LaneVector, 8> lanes_corners(const HexCorners& a, const HexCorners& b) {
@@ -251,50 +188,87 @@ double hex_volume(const HexCorners& p) {
          12.0;
 }
 
+// The four-lane kernel, compiled for AVX2 (the machine's support is checked before it runs).
+#if defined(__x86_64__) && defined(__GNUC__)
+#define HEXREFINE_QUALITY_AVX2 1
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#endif
+namespace lanes4 {
+
+using Lanes = double __attribute__((vector_size(32)));
+using LaneMask = int64_t __attribute__((vector_size(32)));
+constexpr int lane_count = 4;
+
+inline Lanes lanes_sqrt(Lanes v) {
+  return _mm256_sqrt_pd(v);
+}
+
+struct LaneVector {
+  Lanes x, y, z;
+};
+
+/// Points p[0..3] (x, y, z each) into lanes 0..3: their (x, y) pairs loaded whole and
+/// transposed.
+inline LaneVector lanes_gather(const std::array<const double*, 4>& p) {
+  using Two = double __attribute__((vector_size(16)));
+  Two a, b, c, d;
+  std::memcpy(&a, p[0], sizeof a);
+  std::memcpy(&b, p[1], sizeof b);
+  std::memcpy(&c, p[2], sizeof c);
+  std::memcpy(&d, p[3], sizeof d);
+  const Lanes ab = __builtin_shufflevector(a, b, 0, 1, 2, 3);  // x0 y0 x1 y1
+  const Lanes cd = __builtin_shufflevector(c, d, 0, 1, 2, 3);  // x2 y2 x3 y3
+  return {__builtin_shufflevector(ab, cd, 0, 2, 4, 6), __builtin_shufflevector(ab, cd, 1, 3, 5, 7),
+          Lanes{p[0][2], p[1][2], p[2][2], p[3][2]}};
+}
+
+#include "mesh/quality_lanes.inc"
+
+}  // namespace lanes4
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
+#pragma GCC pop_options
+#endif
+#endif
+
 namespace {
 
-/// out[k] = hex_scaled_jacobian of hex hex_of(k), k < out.size(), two hexes per evaluation; and
-/// volumes[k] = its hex_volume when `volumes` is not empty.
-template <class HexOf>
-void scaled_jacobians_in_pairs(const HexMesh& mesh, HexOf hex_of, std::span<double> out,
-                               std::span<double> volumes = {}) {
-  const size_t count = out.size();
-  for (size_t k = 0; k < count; k += 2) {
-    const HexCell& a = mesh.hexes[hex_of(k)];
-    const HexCell& b = mesh.hexes[hex_of(std::min(k + 1, count - 1))];
-    std::array<LaneVector, 8> p;
-    for (int v = 0; v < 8; ++v) {
-      const Eigen::Vector3d &x = mesh.points[a[v]], &y = mesh.points[b[v]];
-      p[v] = {Lanes{x[0], y[0]}, Lanes{x[1], y[1]}, Lanes{x[2], y[2]}};
-    }
-    const Lanes pair = lanes_scaled_jacobian(p);
-    out[k] = pair[0];
-    if (k + 1 < count) out[k + 1] = pair[1];
-    if (volumes.empty()) continue;
-    const Lanes volume = lanes_volume(p);
-    volumes[k] = volume[0];
-    if (k + 1 < count) volumes[k + 1] = volume[1];
-  }
+/// The mesh-wide passes: four hexes per evaluation where the machine has AVX2, else two (the
+/// same values either way).
+void mesh_measures(const HexMesh& mesh, const int32_t* ids, int32_t first, std::span<double> out,
+                   std::span<double> volumes = {}, std::span<double> edge_ratios = {}) {
+#if defined(HEXREFINE_QUALITY_AVX2)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) return lanes4::mesh_measures_in_lanes(mesh, ids, first, out, volumes, edge_ratios);
+#endif
+  lanes2::mesh_measures_in_lanes(mesh, ids, first, out, volumes, edge_ratios);
 }
 
 }  // namespace
 
 void mesh_scaled_jacobians(const HexMesh& mesh, int32_t first, std::span<double> out) {
-  scaled_jacobians_in_pairs(
-      mesh, [&](size_t k) { return first + static_cast<int32_t>(k); }, out);
+  mesh_measures(mesh, nullptr, first, out);
 }
 
 void mesh_scaled_jacobians_and_volumes(const HexMesh& mesh, int32_t first,
                                        std::span<double> scaled_jacobians,
                                        std::span<double> volumes) {
-  scaled_jacobians_in_pairs(
-      mesh, [&](size_t k) { return first + static_cast<int32_t>(k); }, scaled_jacobians, volumes);
+  mesh_measures(mesh, nullptr, first, scaled_jacobians, volumes);
+}
+
+void mesh_hex_measures(const HexMesh& mesh, int32_t first, std::span<double> scaled_jacobians,
+                       std::span<double> volumes, std::span<double> edge_ratios) {
+  mesh_measures(mesh, nullptr, first, scaled_jacobians, volumes, edge_ratios);
 }
 
 void mesh_scaled_jacobians(const HexMesh& mesh, std::span<const int32_t> hexes,
                            std::span<double> out) {
-  scaled_jacobians_in_pairs(
-      mesh, [&](size_t k) { return hexes[k]; }, out);
+  mesh_measures(mesh, hexes.data(), 0, out);
 }
 
 std::vector<double> mesh_scaled_jacobians(const HexMesh& mesh) {

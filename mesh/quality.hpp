@@ -116,6 +116,12 @@ void mesh_scaled_jacobians_and_volumes(const HexMesh& mesh, int32_t first,
                                        std::span<double> scaled_jacobians,
                                        std::span<double> volumes);
 
+/// mesh_scaled_jacobians_and_volumes and, from the edge lengths its scaled Jacobian computes,
+/// hex_edge_ratio of the same hexes into `edge_ratios` (same size): all three bit-identical to
+/// the per-hex functions, from one gather of each hex's corners (the checker's quality pass).
+void mesh_hex_measures(const HexMesh& mesh, int32_t first, std::span<double> scaled_jacobians,
+                       std::span<double> volumes, std::span<double> edge_ratios);
+
 /// The same for the listed hexes: out[k] = hex_scaled_jacobian of hex hexes[k] (out.size() ==
 /// hexes.size()), bit-identical to calling it hex by hex.
 void mesh_scaled_jacobians(const HexMesh& mesh, std::span<const int32_t> hexes,

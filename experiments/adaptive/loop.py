@@ -174,6 +174,7 @@ def run_loop(comm, problem, variant, options=LoopOptions(), solver=poisson.Solve
 
             clock.start()
             refine_error, levels = None, None
+            hex_levels = graded.current.level if graded is not None else None
             try:
                 if graded is not None:
                     graded.mark(marked)
@@ -220,6 +221,8 @@ def run_loop(comm, problem, variant, options=LoopOptions(), solver=poisson.Solve
                 "degree": solver.degree,
                 "pc": solver.pc,
                 "rtol": solver.rtol,
+                "quadrature_degree": [solver.quadrature_degree,
+                                      solver.singular_quadrature_degree],
                 "ranks": comm.size,
                 "max_dofs": options.max_dofs,
             }
@@ -231,10 +234,13 @@ def run_loop(comm, problem, variant, options=LoopOptions(), solver=poisson.Solve
                                     "%s.%s.%02d.vtu" % (problem.name, variant, step))
                 flags = np.zeros(mesh.hex_count)
                 flags[marked] = 1.0
-                hexrefine.write(mesh, path, compress=True,
-                                cell_data={"indicator": np.sqrt(eta2).tolist(),
-                                           "error_h1": np.sqrt(cell_error).tolist(),
-                                           "marked": flags.tolist()})
+                fields = {"indicator": np.sqrt(eta2).tolist(),
+                          "error_h1": np.sqrt(cell_error).tolist(), "marked": flags.tolist()}
+                if hex_levels is not None:
+                    fields["level"] = hex_levels.astype(float).tolist()
+                elif uniform:
+                    fields["level"] = [float(step)] * mesh.hex_count
+                hexrefine.write(mesh, path, compress=True, cell_data=fields)
                 record["mesh_file"] = path
             stop = (next_mesh is None or record["next_dofs"] > options.max_dofs)
             records.append(record)

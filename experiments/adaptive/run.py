@@ -5,10 +5,13 @@ usage: /usr/bin/python3 experiments/adaptive/run.py --problem lshape
            --methods uniform,selective,sheet --max-dofs N --out OUT.jsonl [--save-meshes DIR]
            [--theta 0.3 | --fraction F] [--estimator residual|oracle] [--degree 1|2]
            [--pc gamg|hypre] [--rtol 1e-10] [--placement P] [--smooth] [--max-steps N]
+           [--singular-quadrature-degree 20]
        mpirun -n 2 /usr/bin/python3 experiments/adaptive/run.py ...   (the same, solved on 2 ranks)
 
 Problems (problems.py): lshape, rockerarm, fichera, smooth. Methods (loop.py): uniform (every hex
-1-27), selective, sheet, selective-trilinear, selective-smooth (untangle placement + smoothing);
+1-27); selective, sheet, selective-trilinear, selective-smooth (untangle placement + smoothing),
+each rebuilt by levels (hierarchy.py: graded, no transition split by a transition again); and
+selective-direct, sheet-direct (the marked hexes of the current mesh refined as they are).
 --placement and --smooth apply to the methods that do not set their own.
 
 Writes one JSON record per (method, step) to OUT (a temporary file renamed at the end) with:
@@ -16,12 +19,14 @@ problem, method, step, hexes, dofs, error_h1 (|u - u_h|_H1), error_l2, estimate 
 estimator's (sum eta_K^2)^(1/2)), effectivity (estimate / error_h1), min_scaled_jacobian and
 mean_scaled_jacobian (the mesh's, from hexrefine's checker), valid (the checker's verdict on the
 mesh: the refinement report's check.valid), solver_iterations (CG), marked (hexes marked at this
-step), next_dofs (the DOFs of the mesh the step's refinement made; above the budget the loop
-stops), seconds and cpu_seconds (solve: transfer to dolfinx + assembly + CG; estimate; mark;
-refine: the refinement of this step's marked hexes; error: the true errors), solve_seconds,
-refine_method, placement, smooth, estimator, marking, theta, fraction, degree, pc, rtol, ranks,
-max_dofs, mesh_file (with --save-meshes: the step's mesh as .vtu with the cell fields indicator,
-error_h1 and marked), refine_error (when hexrefine refused the refinement and the loop ended).
+step), level_targets (graded: the targets of each level's refinement), next_dofs (the DOFs of the
+mesh the step's refinement made; above the budget the loop stops), seconds and cpu_seconds
+(solve: transfer to dolfinx + assembly + CG; estimate; mark; refine: the refinement of this
+step's marks; error: the true errors), solve_seconds, refine_method, placement, smooth,
+estimator, marking, theta, fraction, degree, pc, rtol, quadrature_degree, ranks, max_dofs,
+mesh_file (with --save-meshes: the step's mesh as .vtu with the cell fields indicator, error_h1,
+marked and, for graded and uniform methods, level), refine_error (when hexrefine refused the
+refinement and the loop ended).
 Prints a progress line per step. Exit 2 on bad usage, 1 if a solve or refinement fails.
 
 hexrefine is imported from PYTHONPATH, else from the build tree (build/experiments/python).
@@ -70,6 +75,9 @@ def parse_arguments(argv):
     parser.add_argument("--degree", type=int, choices=[1, 2], default=1)
     parser.add_argument("--pc", choices=["gamg", "hypre"], default="gamg")
     parser.add_argument("--rtol", type=float, default=1e-10)
+    parser.add_argument("--singular-quadrature-degree", type=int, default=20,
+                        help="for the errors on the hexes touching the singular set (6: the "
+                        "issue's baselines)")
     parser.add_argument("--placement", choices=["optimized", "trilinear", "untangle"])
     parser.add_argument("--smooth", action="store_true")
     args = parser.parse_args(argv)
@@ -110,7 +118,8 @@ def main(argv):
                                theta=args.theta, fraction=args.fraction or 0.1,
                                estimator=args.estimator, placement=args.placement,
                                smooth=args.smooth, save_meshes=args.save_meshes)
-    solver = poisson.SolverOptions(degree=args.degree, pc=args.pc, rtol=args.rtol)
+    solver = poisson.SolverOptions(degree=args.degree, pc=args.pc, rtol=args.rtol,
+                                   singular_quadrature_degree=args.singular_quadrature_degree)
     temporary = "%s.tmp%d" % (args.out, os.getpid())
     out = None
     if comm.rank == 0:

@@ -63,6 +63,28 @@ def hex_reference_coordinates(corners, points, iterations=12):
     return xi
 
 
+def hex_children_grid_cells(parents, xi):
+    """The cell (0..26, (i * 3 + j) * 3 + k) of the 3 x 3 x 3 split each child occupies, from the
+    reference coordinates xi (n, 3) of the children's centroids in their parent (parents (n,),
+    27 children each): by rank within the parent, the 9 smallest xi_x are i = 0, and so on per
+    axis. Unlike rounding 3 xi, ranks survive smoothing, which moves the children's nodes off the
+    thirds."""
+    by_x = np.lexsort((xi[:, 0], parents)).reshape(-1, 27)
+    if len(by_x) * 27 != len(parents) or (parents[by_x] != parents[by_x[:, :1]]).any():
+        raise RuntimeError("graded refinement: a full split without 27 children")
+    # i: rank of xi_x among the parent's 27 children (in nines); j: of xi_y among the 9 with the
+    # same i (in threes); k: of xi_z among the 3 with the same (i, j).
+    i = np.empty(len(parents), dtype=np.int64)
+    i[by_x] = np.repeat(np.arange(3), 9)
+    by_y = np.lexsort((xi[:, 1], i, parents)).reshape(-1, 9)
+    j = np.empty_like(i)
+    j[by_y] = np.repeat(np.arange(3), 3)
+    by_z = np.lexsort((xi[:, 2], j, i, parents)).reshape(-1, 3)
+    k = np.empty_like(i)
+    k[by_z] = np.arange(3)
+    return (i * 3 + j) * 3 + k
+
+
 def hexes_touching(mesh_hexes, point_count, chosen):
     """Bool mask (m,): the hexes sharing a node with a chosen hex (chosen ones included)."""
     touched = np.zeros(point_count, dtype=bool)
@@ -179,9 +201,7 @@ class GradedRefinement:
         child_xi = hex_reference_coordinates(
             level.points[level.hexes[child_parents]],
             above.points[above.hexes[children]].mean(axis=1))
-        child_cell = np.clip(np.floor(child_xi * 3), 0, 2).astype(np.int64)
-        child_key = child_parents * 27 + (child_cell[:, 0] * 3 + child_cell[:, 1]) * 3 + \
-            child_cell[:, 2]
+        child_key = child_parents * 27 + hex_children_grid_cells(child_parents, child_xi)
         by_key = dict(zip(child_key.tolist(), children.tolist()))
         if len(by_key) != len(children):
             raise RuntimeError("graded refinement: two children of a hex at the same place")

@@ -78,3 +78,24 @@ def test_reference_coordinates_invert_the_trilinear_map():
     points = np.einsum("ni,nik->nk", shape, corners)
     np.testing.assert_allclose(hierarchy.hex_reference_coordinates(corners, points), xi,
                                atol=1e-12)
+
+
+def test_children_grid_cells_follow_the_split_also_after_smoothing():
+    mesh = problems.structured_hex_mesh([0, 0, 0], [3, 1, 1], [3, 1, 1])
+    for smooth in (False, True):
+        refined, report = hexrefine.refine(mesh, [0, 1], smooth=smooth, placement="untangle")
+        parents = refined.attributes["parent_hex"].astype(np.int64)
+        children = np.flatnonzero(np.isin(parents, [0, 1]))
+        centroids = refined.points[refined.hexes[children]].mean(axis=1)
+        xi = hierarchy.hex_reference_coordinates(mesh.points[mesh.hexes[parents[children]]],
+                                                 centroids)
+        cells = hierarchy.hex_children_grid_cells(parents[children], xi)
+        for parent in (0, 1):
+            assert sorted(cells[parents[children] == parent]) == list(range(27))
+        if not smooth:
+            rounded = np.floor(3 * xi).astype(int)
+            np.testing.assert_array_equal(cells, (rounded[:, 0] * 3 + rounded[:, 1]) * 3 +
+                                          rounded[:, 2])
+        else:
+            # Smoothing moved the children (their centroids are off the thirds' centres).
+            assert np.abs(3 * xi - np.floor(3 * xi) - 0.5).max() > 0.01

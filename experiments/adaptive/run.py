@@ -24,6 +24,7 @@ mesh the step's refinement made; above the budget the loop stops), seconds and c
 (solve: transfer to dolfinx + assembly + CG; estimate; mark; refine: the refinement of this
 step's marks; error: the true errors), solve_seconds, refine_method, placement, smooth,
 estimator, marking, theta, fraction, degree, pc, rtol, quadrature_degree, ranks, max_dofs,
+commit (this repository's),
 mesh_file (with --save-meshes: the step's mesh as .vtu with the cell fields indicator, error_h1,
 marked and, for graded and uniform methods, level), refine_error (when hexrefine refused the
 refinement and the loop ended).
@@ -36,6 +37,7 @@ import argparse
 import json
 import os
 import pathlib
+import subprocess
 import sys
 import time
 
@@ -109,9 +111,20 @@ def progress(record):
         print("  refinement refused: " + record["refine_error"], flush=True)
 
 
+def source_commit():
+    """The repository's commit (short), for the records; 'unknown' outside a git checkout."""
+    try:
+        out = subprocess.run(["git", "-C", str(HERE), "rev-parse", "--short", "HEAD"],
+                             capture_output=True, text=True, timeout=10)
+        return out.stdout.strip() or "unknown"
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
 def main(argv):
     args = parse_arguments(argv)
     comm = MPI.COMM_WORLD
+    commit = source_commit() if comm.rank == 0 else None
     problem = problems.PROBLEMS[args.problem]
     options = loop.LoopOptions(max_dofs=args.max_dofs, max_steps=args.max_steps,
                                marking="fraction" if args.fraction else "doerfler",
@@ -127,6 +140,7 @@ def main(argv):
         out = open(temporary, "w")
 
     def on_record(record):
+        record["commit"] = commit
         out.write(json.dumps(record, sort_keys=True) + "\n")
         out.flush()
         progress(record)

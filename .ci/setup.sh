@@ -8,7 +8,8 @@ set -euo pipefail
 packages=(cmake g++ make clang-format libeigen3-dev libopenmesh-dev nlohmann-json3-dev libgtest-dev
           libbenchmark-dev libexodusii-dev python3-meshio python3-vtk9 python3-matplotlib gmsh
           clang-14 libclang-rt-14-dev pybind11-dev python3-dev python3-numpy python3-pytest
-          python3-jsonschema zlib1g-dev valgrind)
+          python3-jsonschema zlib1g-dev valgrind
+          python3-dolfinx)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -4,6 +4,7 @@
 # pybind11-dev, python3-dev, python3-numpy and python3-pytest build and test the Python module;
 # python3-jsonschema validates reports and records against docs/schema/.
 # valgrind counts the instructions of the performance gate (hexrefine bench --instructions).
+# python3-dolfinx solves the adaptive loop's Poisson problems (experiments/adaptive).
 set -euo pipefail
 packages=(cmake g++ make clang-format libeigen3-dev libopenmesh-dev nlohmann-json3-dev libgtest-dev
           libbenchmark-dev libexodusii-dev python3-meshio python3-vtk9 python3-matplotlib gmsh

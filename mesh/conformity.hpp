@@ -80,10 +80,19 @@
 /// the reference is planar (out-of-plane spread <= 1e-12 x its diagonal), refinement must preserve
 /// both to mesh_check_geometry_tolerance relative; otherwise the errors are only reported.
 ///
-/// Time: linear in the mesh size: faces matched by hex_face_adjacency_build (no general
-/// topology), hash grids over the boundary faces, duplicate nodes by a counting sort of the
-/// points into cells. Memory at its peak: about 32 bytes per hex beyond the mesh itself (the face
-/// slots and the bucket counts; doublets are found while matching, without a neighbour array).
+/// Time: linear in the mesh size, every pass on up to `threads` threads: one pass over the hexes
+/// (their ids, the nodes they use, the scaled Jacobian, volume and edge ratio from one gather of
+/// their corners, four hexes per evaluation where the machine has AVX2: mesh_hex_measures),
+/// faces matched by hex_face_adjacency_build (a counting sort of the face slots by lowest node;
+/// no general topology), duplicate nodes by a counting sort of the points into cells compared on
+/// float keys, boundary edges counted by a radix sort of their keys, and hash grids over the
+/// boundary faces for the geometric tests. Memory at its peak: about 32 bytes per hex beyond the
+/// mesh itself (the face slots and the per-thread bucket counts; doublets are found while
+/// matching, without a neighbour array). Every figure of the report is the same for any thread
+/// count (sums per fixed chunk, combined in chunk order).
+/// Not done: certifying only the part a refinement changed. The checker knows nothing of how a
+/// mesh was made, and a full refinement (the case measured in results/performance.md) changes
+/// every hex, so there would be nothing to skip.
 
 #include <cstdint>
 #include <nlohmann/json.hpp>

@@ -223,6 +223,8 @@ def run_loop(comm, problem, variant, options=LoopOptions(), solver=poisson.Solve
                 "rtol": solver.rtol,
                 "quadrature_degree": [solver.quadrature_degree,
                                       solver.singular_quadrature_degree],
+                "estimator_size": solver.estimator_size,
+                "estimator_laplacian": solver.estimator_laplacian,
                 "ranks": comm.size,
                 "max_dofs": options.max_dofs,
             }

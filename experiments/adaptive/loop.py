@@ -14,6 +14,7 @@ indicators come back to rank 0 by hex id. Only rank 0 gets records.
 """
 
 import dataclasses
+import gc
 import os
 import time
 
@@ -249,6 +250,10 @@ def run_loop(comm, problem, variant, options=LoopOptions(), solver=poisson.Solve
             if on_record is not None:
                 on_record(record)
         stop = comm.bcast(stop, root=0)
+        # The step's dolfinx mesh, spaces and forms hold cycles; free them before the next
+        # (larger) mesh is built rather than when the collector gets to them.
+        del dmesh, solution
+        gc.collect()
         if stop:
             break
         if root:

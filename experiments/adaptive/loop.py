@@ -4,8 +4,9 @@ the refinement variants the study compares.
 One step on the current mesh: solve (poisson.solve, with the transfer to dolfinx), estimate (the
 residual indicators eta_K^2, or the exact error per hex for the oracle), measure the true errors,
 mark (Doerfler bulk marking: the fewest hexes whose indicators sum to theta of the total; or a fixed
-fraction of the hexes, largest indicators first), refine the marked hexes with hexrefine (uniform:
-every hex, the `all` selection). The loop ends when the refined mesh has more DOFs than the budget
+fraction of the hexes, largest indicators first), refine with hexrefine: uniform every hex (the
+`all` selection); graded variants rebuild the mesh by levels for the marks so far (hierarchy.py);
+direct variants refine the marked hexes of the current mesh. The loop ends when the refined mesh has more DOFs than the budget
 (it is not solved), when hexrefine refuses a refinement, or after max_steps steps.
 
 Under MPI every rank runs the loop: the hexrefine mesh lives on rank 0, which marks and refines

@@ -4,8 +4,9 @@ the refinement variants the study compares.
 One step on the current mesh: solve (poisson.solve, with the transfer to dolfinx), estimate (the
 residual indicators eta_K^2, or the exact error per hex for the oracle), measure the true errors,
 mark (Doerfler bulk marking: the fewest hexes whose indicators sum to theta of the total; or a fixed
-fraction of the hexes, largest indicators first), refine the marked hexes with hexrefine (uniform:
-every hex, the `all` selection). The loop ends when the refined mesh has more DOFs than the budget
+fraction of the hexes, largest indicators first), refine with hexrefine: uniform every hex (the
+`all` selection); graded variants rebuild the mesh by levels for the marks so far (hierarchy.py);
+direct variants refine the marked hexes of the current mesh. The loop ends when the refined mesh has more DOFs than the budget
 (it is not solved), when hexrefine refuses a refinement, or after max_steps steps.
 
 Under MPI every rank runs the loop: the hexrefine mesh lives on rank 0, which marks and refines
@@ -14,6 +15,7 @@ indicators come back to rank 0 by hex id. Only rank 0 gets records.
 """
 
 import dataclasses
+import gc
 import os
 import time
 
@@ -223,6 +225,8 @@ def run_loop(comm, problem, variant, options=LoopOptions(), solver=poisson.Solve
                 "rtol": solver.rtol,
                 "quadrature_degree": [solver.quadrature_degree,
                                       solver.singular_quadrature_degree],
+                "estimator_size": solver.estimator_size,
+                "estimator_laplacian": solver.estimator_laplacian,
                 "ranks": comm.size,
                 "max_dofs": options.max_dofs,
             }
@@ -247,6 +251,10 @@ def run_loop(comm, problem, variant, options=LoopOptions(), solver=poisson.Solve
             if on_record is not None:
                 on_record(record)
         stop = comm.bcast(stop, root=0)
+        # The step's dolfinx mesh, spaces and forms hold cycles; free them before the next
+        # (larger) mesh is built rather than when the collector gets to them.
+        del dmesh, solution
+        gc.collect()
         if stop:
             break
         if root:

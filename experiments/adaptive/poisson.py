@@ -15,16 +15,22 @@ hexrefine's hex ids.
 
 The residual estimator (Verfurth's residual estimator for the Poisson problem) on a hex K:
 
-    eta_K^2 = h_K^2 ||f + div grad u_h||_K^2 + 1/2 sum_{F interior face of K} h_F ||[grad u_h . n]||_F^2
+    eta_K^2 = h_K^2 ||f + div grad u_h||_K^2
+              + 1/2 sum_{F interior face of K} h_F ||[grad u_h . n]||_F^2
 
-- h_K is the cell's diameter: the largest distance between two of its 8 vertices (UFL's
-  CellDiameter, on a hex one of its four space diagonals for a brick).
-- h_F is the mean of h_K over the two hexes sharing the face F (UFL's avg(CellDiameter)); UFL
-  cannot measure a non-affine face of a hex (FacetArea, MaxFacetEdgeLength), and for the graded
-  meshes here the two are within the transition templates' factor 3 of each other.
-- div grad u_h is computed exactly: on a trilinear hex that is not a parallelepiped the Jacobian
-  varies over the cell, and even on a parallelepiped the Q1 space's mixed terms (xi eta, ...) give a
-  non-zero Laplacian, so the term is not dropped. UFL differentiates through the inverse Jacobian.
+- h_K = |K|^(1/3), the cube root of the hex's volume (SolverOptions.estimator_size 'volume'; or
+  'diameter': the largest distance between two of its vertices, UFL's CellDiameter). On the
+  transition hexes, long and flat, the diameter overstates the size across the thin direction;
+  the volume's cube root keeps the effectivity index steadier (results/adaptive.md, estimator
+  variants).
+- h_F is the mean of h_K over the two hexes sharing the face F: UFL cannot measure a non-affine
+  face of a hex (FacetArea, MaxFacetEdgeLength refuse it).
+- div grad u_h is computed exactly (estimator_laplacian True; False drops it): on a trilinear hex
+  that is not a parallelepiped the Jacobian varies over the cell, and even on a parallelepiped the
+  Q1 space's mixed terms (xi eta, ...) have a non-zero Laplacian. UFL differentiates through the
+  inverse Jacobian (a linear function's Laplacian is 0 to rounding on distorted hexes, tested). On
+  nested transitions (refining transitions again) this term grows with the distortion rather than
+  the error and misleads the marking; on graded meshes it does not (results/adaptive.md).
 - [grad u_h . n] = grad u_h(+) . n(+) + grad u_h(-) . n(-) is the jump of the normal derivative;
   every boundary face is a Dirichlet face and has no jump term.
 - Each interior face's term is shared half and half by its two hexes (the factor 1/2).
@@ -77,7 +83,7 @@ class SolverOptions:
     quadrature_degree: int = 6
     singular_quadrature_degree: int = 20
     estimator_laplacian: bool = True
-    estimator_size: str = "volume"
+    estimator_size: str = "volume"  # or "diameter"
 
 
 @dataclasses.dataclass

@@ -5,7 +5,7 @@ usage: /usr/bin/python3 experiments/adaptive/run.py --problem lshape
            --methods uniform,selective,sheet --max-dofs N --out OUT.jsonl [--save-meshes DIR]
            [--theta 0.3 | --fraction F] [--estimator residual|oracle] [--degree 1|2]
            [--pc gamg|hypre] [--rtol 1e-10] [--placement P] [--smooth] [--max-steps N]
-           [--singular-quadrature-degree 20]
+           [--singular-quadrature-degree 20] [--estimator-size volume|diameter] [--no-laplacian]
        mpirun -n 2 /usr/bin/python3 experiments/adaptive/run.py ...   (the same, solved on 2 ranks)
 
 Problems (problems.py): lshape, rockerarm, fichera, smooth. Methods (loop.py): uniform (every hex
@@ -48,7 +48,7 @@ try:
 except ImportError:
     sys.path.insert(0, str(HERE.parents[1] / "build" / "experiments" / "python"))
     try:
-        import hexrefine  # noqa: F401
+        import hexrefine  # noqa: F401,F811
     except ImportError:
         sys.stderr.write("run.py: cannot import hexrefine: build it (cmake --build build) or set "
                          "PYTHONPATH to build/experiments/python\n")
@@ -77,6 +77,10 @@ def parse_arguments(argv):
     parser.add_argument("--degree", type=int, choices=[1, 2], default=1)
     parser.add_argument("--pc", choices=["gamg", "hypre"], default="gamg")
     parser.add_argument("--rtol", type=float, default=1e-10)
+    parser.add_argument("--estimator-size", choices=["volume", "diameter"], default="volume",
+                        help="h_K: |K|^(1/3) or the largest vertex distance")
+    parser.add_argument("--no-laplacian", action="store_true",
+                        help="drop div grad u_h from the element residual")
     parser.add_argument("--singular-quadrature-degree", type=int, default=20,
                         help="for the errors on the hexes touching the singular set (6: the "
                         "issue's baselines)")
@@ -132,7 +136,9 @@ def main(argv):
                                estimator=args.estimator, placement=args.placement,
                                smooth=args.smooth, save_meshes=args.save_meshes)
     solver = poisson.SolverOptions(degree=args.degree, pc=args.pc, rtol=args.rtol,
-                                   singular_quadrature_degree=args.singular_quadrature_degree)
+                                   singular_quadrature_degree=args.singular_quadrature_degree,
+                                   estimator_size=args.estimator_size,
+                                   estimator_laplacian=not args.no_laplacian)
     temporary = "%s.tmp%d" % (args.out, os.getpid())
     out = None
     if comm.rank == 0:

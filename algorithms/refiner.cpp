@@ -1,5 +1,6 @@
 #include "algorithms/refiner.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <string>
@@ -82,14 +83,25 @@ std::vector<int32_t> placement_fallback_untangle(HexMesh& refined,
   const std::vector<double> before = mesh_scaled_jacobians(refined);
   for (int32_t h = 0; h < refined.hex_count(); ++h)
     if (!(before[h] > 0)) inverted.push_back(h);
+  // Validity first: the sweeps visit every node of the region (visit_below 1) and, if the
+  // edge-ratio cap holds a child inverted, run again without it over a wider region (an inverted
+  // child has no quality to protect; a collapsed edge shows in the report's max_edge_ratio).
   SmoothOptions smoothing;
   smoothing.region_hexes = inverted;
   smoothing.layers = 2;
+  smoothing.visit_below = 1;
   smoothing.reference = &reference;
   smoothing.reference_nodes = input_nodes;
   smoothing.threads = options.threads;
   smoothing.max_edge_ratio = options.placement.max_edge_ratio;
   mesh_smooth(refined, smoothing);
+  if (std::ranges::any_of(inverted, [&](int32_t h) {
+        return !(hex_scaled_jacobian(hex_points(refined, h)) > 0);
+      })) {
+    smoothing.layers = 4;
+    smoothing.max_edge_ratio = 0;
+    mesh_smooth(refined, smoothing);
+  }
   const std::vector<double> after = mesh_scaled_jacobians(refined);
   const std::vector<int32_t>* original = mesh_find_attribute(refined, attribute_parent_hex);
   std::vector<int32_t> stuck;  // input hexes whose children stay inverted

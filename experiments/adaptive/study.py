@@ -818,6 +818,16 @@ def large_section(large):
                 method, r["step"], fmt(r["dofs"]), fmt(r["error_h1"], 4),
                 fmt(r["min_scaled_jacobian"]), r["solver_iterations"],
                 " / ".join("%.1f" % r["cpu_seconds"][p] for p in PHASES)))
+    uni, sel = curves.get("uniform", []), curves.get("selective", [])
+    if uni and sel:
+        hit = first_step_at_error(sel, uni[-1]["error_h1"])
+        rows.append("")
+        rows.append("Uniform's finest error here, %s at %s DOFs, is reached by selective %s; "
+                    "selective's rate over its last four steps: %s (uniform's last three: %s)." % (
+                        fmt(uni[-1]["error_h1"]), fmt(uni[-1]["dofs"]),
+                        "at step %d with %s DOFs (%s x)" % (hit["step"], fmt(hit["dofs"]),
+                                                           fmt(hit["dofs"] / uni[-1]["dofs"]))
+                        if hit else "not within the budget", fmt(rate(sel)), fmt(rate(uni, 3))))
     return "\n".join(rows)
 
 

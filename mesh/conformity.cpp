@@ -298,7 +298,9 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box_on_threads(const H
 int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
-  const auto [lo, hi] = mesh_bounding_box_on_threads(mesh, threads);
+  // Named copies, not a structured binding: clang 14 (the fuzz build) cannot capture a binding.
+  const auto box = mesh_bounding_box_on_threads(mesh, threads);
+  const Eigen::Vector3d lo = box.first, hi = box.second;
   const double tolerance = mesh_check_duplicate_tolerance * (hi - lo).norm();
   const double extent = (hi - lo).maxCoeff();
   const double cell =

@@ -311,8 +311,11 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   for (int d = 0; d < 3; ++d)
     dims[d] = std::clamp<int64_t>(static_cast<int64_t>((hi[d] - origin[d]) / cell) + 1, 1,
                                   int64_t{1} << 21);
+  // By the reciprocal: a point next to a wall may land in the cell beside its own, and the wall
+  // tests below, made against the cell it landed in, still send it to look across that wall.
+  const double cells_per_unit = 1.0 / cell;
   auto cell_index = [&](double x, int d) {
-    const double k = std::floor((x - origin[d]) / cell);
+    const double k = std::floor((x - origin[d]) * cells_per_unit);
     return k >= 0.0 ? std::min(static_cast<int64_t>(k), dims[d] - 1) : int64_t{0};  // NaN: 0
   };
   auto cell_of = [&](int64_t x, int64_t y, int64_t z) { return (z * dims[1] + y) * dims[0] + x; };
@@ -516,18 +519,25 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
     for (int64_t h = begin; h < end; ++h)
       for (int32_t v : mesh.hexes[h])
         std::atomic_ref<char>(used[v]).store(1, std::memory_order_relaxed);
-    std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin)),
-        volumes(static_cast<size_t>(end - begin)), edge_ratios(static_cast<size_t>(end - begin));
-    mesh_hex_measures(mesh, static_cast<int32_t>(begin), scaled_jacobians, volumes, edge_ratios);
-    for (int32_t h = static_cast<int32_t>(begin); h < end; ++h) {
-      const double sj = scaled_jacobians[h - begin];
-      s.scaled_jacobian_sum += sj;
-      s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
-      s.volume += volumes[h - begin];
-      s.max_edge_ratio = std::max(s.max_edge_ratio, edge_ratios[h - begin]);
-      ++s.histogram[scaled_jacobian_bin(sj)];
-      if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
-        s.defects.push_back(h);
+    // Measured in blocks whose values fit on the stack (a heap array per chunk would be fresh
+    // memory each time), summed in hex order.
+    constexpr int64_t block = 256;
+    std::array<double, block> scaled_jacobians, volumes, edge_ratios;
+    for (int64_t first = begin; first < end; first += block) {
+      const size_t count = static_cast<size_t>(std::min(block, end - first));
+      mesh_hex_measures(mesh, static_cast<int32_t>(first), {scaled_jacobians.data(), count},
+                        {volumes.data(), count}, {edge_ratios.data(), count});
+      for (size_t k = 0; k < count; ++k) {
+        const int32_t h = static_cast<int32_t>(first + static_cast<int64_t>(k));
+        const double sj = scaled_jacobians[k];
+        s.scaled_jacobian_sum += sj;
+        s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
+        s.volume += volumes[k];
+        s.max_edge_ratio = std::max(s.max_edge_ratio, edge_ratios[k]);
+        ++s.histogram[scaled_jacobian_bin(sj)];
+        if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
+          s.defects.push_back(h);
+      }
     }
   });
   for (const ChunkSums& s : sums)

@@ -292,9 +292,10 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box_on_threads(const H
 /// bucketed by a coarse cell (about four points per cell, one counting sort); near pairs share a
 /// cell unless they straddle a cell wall, so only points within the tolerance of a wall also
 /// search the neighbouring cells. The cell size is an irrational multiple of the mean spacing so
-/// structured grids do not put their points on the walls. A crowded cell (a refined region is
-/// far denser than the box's mean) is sorted by x and swept, comparing only pairs within the
-/// tolerance in x: k log k for k points, quadratic only if they share an x within the tolerance.
+/// structured grids do not put their points on the walls. Pairs are compared on float keys first
+/// (below). A crowded cell (a refined region is far denser than the box's mean) is sorted by key
+/// and swept, comparing only pairs within the key tolerance: k log k for k points, quadratic only
+/// if their keys fall within it.
 int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
@@ -369,8 +370,9 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   // float: two points within the tolerance have keys within key_tolerance (the projection moves
   // by at most key_slopes x their distance, rounding to float by half a float ulp, at most
   // 2^-24 x key_slopes x extent, each), so pairs are compared on their keys, next to each other in
-  // the cell, and only pairs with close keys read both points (scattered over the mesh). Structured
-  // grids, whose points share coordinates, have no two points with the same key in a cell.
+  // the cell, and only pairs with close keys read both points (scattered over the mesh). The slopes
+  // are irrational so that the points of a structured grid, which share coordinates, do not share
+  // keys.
   const Eigen::Vector3d slopes(1.0, 0.7548776662, 0.5698402910);  // 1, 1/phi_3, 1/phi_3^2
   const double key_slopes = slopes.sum();
   const double key_tolerance =

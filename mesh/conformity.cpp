@@ -10,11 +10,9 @@
 #include <cstring>
 #include <limits>
 #include <memory>
-#include <new>
 #include <numbers>
 #include <numeric>
 #include <optional>
-#include <span>
 #include <string>
 #include <unordered_map>
 
@@ -298,7 +296,7 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box_on_threads(const H
 /// (below). A crowded cell (a refined region is far denser than the box's mean) is sorted by key
 /// and swept, comparing only pairs within the key tolerance: k log k for k points, quadratic only
 /// if their keys fall within it.
-int64_t count_duplicate_nodes(const HexMesh& mesh, int threads, std::span<std::byte> scratch) {
+int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
   const auto [lo, hi] = mesh_bounding_box_on_threads(mesh, threads);
@@ -324,33 +322,9 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads, std::span<std::b
   auto cell_of = [&](int64_t x, int64_t y, int64_t z) { return (z * dims[1] + y) * dims[0] + x; };
   const int64_t cells = dims[0] * dims[1] * dims[2];
   constexpr int64_t chunk_points = 1 << 12;
-  // The arrays of the search in `scratch` when it is large enough (memory the face matching
-  // reuses next), else fresh: the keyed points (8 bytes per point), each point's cell (4), the
-  // duplicate flags (1), and each part's counts per cell (4 per cell). The points' arrays are
-  // written in full before they are read: no zero fill.
-  struct KeyedPoint {
-    float key;
-    int32_t point;
-  };
-  const int parts =
-      static_cast<int>(std::clamp<int64_t>(threads, 1, std::clamp<int64_t>(n / 65536, 1, 4)));
-  const size_t points = static_cast<size_t>(n);
-  const size_t counts_at = (13 * points + 3) / 4 * 4;
-  const bool borrowed =
-      scratch.size() >= counts_at + size_t{4} * static_cast<size_t>(cells) * parts;
-  std::unique_ptr<KeyedPoint[]> own_sorted(borrowed ? nullptr : new KeyedPoint[n]);
-  std::unique_ptr<uint32_t[]> own_cells(borrowed ? nullptr : new uint32_t[n]);
-  std::unique_ptr<char[]> own_duplicate(borrowed ? nullptr : new char[n]);
-  std::byte* next = scratch.data();
-  KeyedPoint* sorted = borrowed ? new (next) KeyedPoint[n] : own_sorted.get();
-  uint32_t* cell_of_point = borrowed ? new (next + 8 * points) uint32_t[n] : own_cells.get();
-  char* duplicate = borrowed ? new (next + 12 * points) char[n] : own_duplicate.get();
-  std::vector<std::vector<uint32_t>> own_counts(borrowed ? 0 : static_cast<size_t>(parts));
-  std::vector<std::span<uint32_t>> offsets(static_cast<size_t>(parts));
-  for (int p = 0; borrowed && p < parts; ++p) {
-    const size_t at = counts_at + size_t{4} * static_cast<size_t>(cells) * p;
-    offsets[p] = {new (next + at) uint32_t[static_cast<size_t>(cells)], static_cast<size_t>(cells)};
-  }
+  // Both index arrays are written in full before they are read: no zero fill (fresh pages cost
+  // more to touch than to compute here).
+  std::unique_ptr<uint32_t[]> cell_of_point(new uint32_t[n]);
   // The cell of p in k, and for each axis whether p lies within the tolerance of the cell's lower
   // (low = -1) or upper (high = 1) wall toward another cell; returns whether it does on any axis.
   auto point_cell = [&](const Eigen::Vector3d& p, int64_t k[3], int low[3], int high[3]) {
@@ -381,17 +355,15 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads, std::span<std::b
   // gives each range its place in every cell, and each range scatters its points there, so a
   // cell's points stay in ascending order for any thread count. offsets[p][c] counts, then
   // starts, then ends; the last range's ends are the cells' ends.
+  const int parts =
+      static_cast<int>(std::clamp<int64_t>(threads, 1, std::clamp<int64_t>(n / 65536, 1, 4)));
   auto part_begin = [&](int p) { return static_cast<int32_t>(int64_t{n} * p / parts); };
+  std::vector<std::vector<uint32_t>> offsets(static_cast<size_t>(parts));
   parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
-    if (borrowed) {
-      std::fill(offsets[p].begin(), offsets[p].end(), 0);
-    } else {
-      own_counts[p].assign(static_cast<size_t>(cells), 0);
-      offsets[p] = own_counts[p];
-    }
-    const std::span<uint32_t> count = offsets[p];
-    const int32_t last = part_begin(static_cast<int>(p) + 1);
-    for (int32_t i = part_begin(static_cast<int>(p)); i < last; ++i) ++count[cell_of_point[i]];
+    std::vector<uint32_t>& count = offsets[p];
+    count.assign(static_cast<size_t>(cells), 0);
+    for (int32_t i = part_begin(static_cast<int>(p)); i < part_begin(static_cast<int>(p) + 1); ++i)
+      ++count[cell_of_point[i]];
   });
   counting_sort_starts(offsets, threads);
   // Each point with a key, its projection on a fixed direction of irrational slopes, rounded to
@@ -410,18 +382,23 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads, std::span<std::b
     // NaN sorts last (as +infinity), so a sort by key is strict and no NaN pair is swept.
     return std::isnan(key) ? std::numeric_limits<float>::infinity() : static_cast<float>(key);
   };
+  struct KeyedPoint {
+    float key;
+    int32_t point;
+  };
+  std::unique_ptr<KeyedPoint[]> sorted(new KeyedPoint[n]);
   parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
-    const std::span<uint32_t> cursor = offsets[p];
-    const int32_t last = part_begin(static_cast<int>(p) + 1);
-    for (int32_t i = part_begin(static_cast<int>(p)); i < last; ++i)
+    std::vector<uint32_t>& cursor = offsets[p];
+    for (int32_t i = part_begin(static_cast<int>(p)); i < part_begin(static_cast<int>(p) + 1); ++i)
       sorted[cursor[cell_of_point[i]]++] = {key_of(mesh.points[i]), i};
   });
-  const std::span<const uint32_t> cell_end = offsets.back();
+  const std::vector<uint32_t> cell_end = std::move(offsets.back());
+  offsets.clear();
   auto cell_begin = [&](int64_t c) { return c == 0 ? uint32_t{0} : cell_end[c - 1]; };
 
   // Pairs are compared per chunk of cells, then per chunk of points near a wall, on every thread;
   // a close pair marks its higher node (atomically: two chunks may mark the same node).
-  std::fill(duplicate, duplicate + n, 0);
+  std::vector<char> duplicate(n, 0);
   auto compare = [&](const KeyedPoint& a, const KeyedPoint& b) {
     if (a.point != b.point && std::abs(double{a.key} - double{b.key}) <= key_tolerance &&
         (mesh.points[a.point] - mesh.points[b.point]).norm() <= tolerance)
@@ -432,8 +409,8 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads, std::span<std::b
   // and swept: only pairs within the key tolerance are compared, so it costs k log k, not k^2.
   parallel_chunks(threads, cells, chunk_points, [&](int64_t, int64_t begin, int64_t end) {
     for (int64_t c = begin; c < end; ++c) {
-      KeyedPoint* first = sorted + cell_begin(c);
-      KeyedPoint* last = sorted + cell_end[c];
+      KeyedPoint* first = sorted.get() + cell_begin(c);
+      KeyedPoint* last = sorted.get() + cell_end[c];
       if (last - first <= 16) {
         for (KeyedPoint* a = first; a < last; ++a)
           for (KeyedPoint* b = a + 1; b < last; ++b) compare(*a, *b);
@@ -465,7 +442,7 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads, std::span<std::b
                           }
                     }
                   });
-  return std::count(duplicate, duplicate + n, 1);
+  return std::count(duplicate.begin(), duplicate.end(), 1);
 }
 
 /// The message mesh_validate_ids gives for the lowest of hexes [begin, end) whose node ids are
@@ -534,15 +511,7 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   };
   constexpr int64_t chunk_hexes = 1 << 14;
   std::vector<ChunkSums> sums(static_cast<size_t>(parallel_chunk_count(r.hexes, chunk_hexes)));
-  // One block of memory for the used-node marks, then the duplicate search, then the face
-  // matching's counts and slots (its size): each pass reuses pages an earlier one touched, where
-  // fresh memory is the dearest part of them all (a virtual machine whose host backs memory
-  // lazily). Uninitialised: each pass fills what it reads.
-  const size_t scratch_bytes =
-      std::max(hex_face_adjacency_scratch_bytes(mesh, threads), static_cast<size_t>(r.nodes));
-  std::unique_ptr<std::byte[]> scratch(new std::byte[scratch_bytes]);
-  char* used = new (scratch.get()) char[static_cast<size_t>(r.nodes)];
-  std::fill(used, used + r.nodes, 0);
+  std::vector<char> used(mesh.points.size(), 0);
   parallel_chunks(threads, r.hexes, chunk_hexes, [&](int64_t chunk, int64_t begin, int64_t end) {
     ChunkSums& s = sums[chunk];
     if (const std::optional<std::string> bad = hexes_bad_ids(mesh, "mesh", begin, end)) {
@@ -580,13 +549,12 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
       throw InputError("mesh: attribute '" + a.name + "' has " + std::to_string(a.values.size()) +
                        " values for " + std::to_string(mesh.hexes.size()) + " hexes");
   if (reference) mesh_validate_ids(*reference, "reference mesh", threads);
-  r.unused_nodes = std::count(used, used + r.nodes, 0);
+  r.unused_nodes = std::count(used.begin(), used.end(), 0);
+  used = {};
 
-  r.duplicate_nodes = count_duplicate_nodes(mesh, threads, {scratch.get(), scratch_bytes});
+  r.duplicate_nodes = count_duplicate_nodes(mesh, threads);
   // Doublets come from the matching itself: no neighbour array (24 bytes per hex) is built.
-  HexFaceAdjacency adjacency =
-      hex_face_adjacency_build(mesh, threads, false, {scratch.get(), scratch_bytes});
-  scratch.reset();
+  HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, threads, false);
   r.nonmanifold_faces = static_cast<int64_t>(adjacency.nonmanifold_faces.size());
 
   // Hexes with a defect: every source offers its lowest mesh_check_defect_hex_limit, so the

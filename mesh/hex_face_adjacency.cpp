@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
-#include <new>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -103,21 +102,9 @@ bool faces_make_doublet(const HexCell& a, int la, const HexCell& b, int lb) {
   return faces_share_another_face(a, la, b);
 }
 
-/// How many contiguous hex ranges count and scatter the slots at once: one per thread, at most
-/// four (the counts of four ranges weigh about half the hexes themselves), none under 4,096 hexes.
-int adjacency_parts(int32_t hexes, int threads) {
-  return static_cast<int>(std::clamp<int64_t>(threads, 1, std::clamp<int64_t>(hexes / 4096, 1, 4)));
-}
-
 }  // namespace
 
-size_t hex_face_adjacency_scratch_bytes(const HexMesh& mesh, int threads) {
-  return size_t{4} * static_cast<size_t>(mesh.point_count()) *
-             static_cast<size_t>(adjacency_parts(mesh.hex_count(), threads)) +
-         size_t{24} * static_cast<size_t>(mesh.hex_count());
-}
-
-uint32_t counting_sort_starts(std::span<const std::span<uint32_t>> counts, int threads) {
+uint32_t counting_sort_starts(std::vector<std::vector<uint32_t>>& counts, int threads) {
   if (counts.empty()) return 0;
   const int64_t buckets = static_cast<int64_t>(counts[0].size());
   constexpr int64_t block = 1 << 16;
@@ -125,7 +112,7 @@ uint32_t counting_sort_starts(std::span<const std::span<uint32_t>> counts, int t
                                     0);
   parallel_chunks(threads, buckets, block, [&](int64_t b, int64_t begin, int64_t end) {
     uint32_t total = 0;
-    for (const std::span<uint32_t> part : counts)
+    for (const std::vector<uint32_t>& part : counts)
       for (int64_t k = begin; k < end; ++k) total += part[k];
     block_start[b + 1] = total;
   });
@@ -133,7 +120,7 @@ uint32_t counting_sort_starts(std::span<const std::span<uint32_t>> counts, int t
   parallel_chunks(threads, buckets, block, [&](int64_t b, int64_t begin, int64_t end) {
     uint32_t running = block_start[b];
     for (int64_t k = begin; k < end; ++k)
-      for (const std::span<uint32_t> part : counts) {
+      for (std::vector<uint32_t>& part : counts) {
         const uint32_t count = part[k];
         part[k] = running;
         running += count;
@@ -142,8 +129,7 @@ uint32_t counting_sort_starts(std::span<const std::span<uint32_t>> counts, int t
   return block_start.back();
 }
 
-HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool neighbors,
-                                          std::span<std::byte> scratch) {
+HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool neighbors) {
   const int32_t hexes = mesh.hex_count();
   if (hexes > hex_face_adjacency_max_hexes)
     throw OperationError("the mesh has " + std::to_string(hexes) +
@@ -158,38 +144,23 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
   // where range p's part of node a's bucket starts, and after the scatter where it ends: the last
   // range's ends are the buckets' ends. Each range holds a count per node, so at most four
   // (the counts of four ranges weigh about half the hexes themselves).
-  const int parts = adjacency_parts(hexes, threads);
+  const int parts =
+      static_cast<int>(std::clamp<int64_t>(threads, 1, std::clamp<int64_t>(hexes / 4096, 1, 4)));
   auto part_begin = [&](int p) { return static_cast<int32_t>(int64_t{hexes} * p / parts); };
-  // The counts and then the slots in the lent scratch when it is large enough, else fresh. The
-  // slots are left uninitialised: the scatter writes every entry, so its threads, not a serial
-  // zero fill, are the first to touch these pages (24 bytes per hex, the largest array of the
-  // checker).
-  const bool lent = scratch.size() >= hex_face_adjacency_scratch_bytes(mesh, threads);
-  std::vector<std::vector<uint32_t>> own_counts(lent ? 0 : static_cast<size_t>(parts));
-  std::vector<std::span<uint32_t>> offsets(static_cast<size_t>(parts));
-  for (int p = 0; p < parts; ++p)
-    offsets[p] = lent ? std::span<uint32_t>(new (scratch.data() + size_t{4} * nodes * p)
-                                                uint32_t[static_cast<size_t>(nodes)],
-                                            static_cast<size_t>(nodes))
-                      : std::span<uint32_t>();
+  std::vector<std::vector<uint32_t>> offsets(static_cast<size_t>(parts));
   parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
-    if (!lent) {
-      own_counts[p].assign(static_cast<size_t>(nodes), 0);
-      offsets[p] = own_counts[p];
-    } else {
-      std::fill(offsets[p].begin(), offsets[p].end(), 0);
-    }
-    const std::span<uint32_t> count = offsets[p];
+    std::vector<uint32_t>& count = offsets[p];
+    count.assign(static_cast<size_t>(nodes), 0);
     const int32_t last = part_begin(static_cast<int>(p) + 1);
     for (int32_t h = part_begin(static_cast<int>(p)); h < last; ++h)
       for (const int32_t lowest : hex_face_lowest_nodes(mesh.hexes[h])) ++count[lowest];
   });
   const uint32_t running = counting_sort_starts(offsets, threads);
-  std::unique_ptr<uint32_t[]> own_slots(lent ? nullptr : new uint32_t[running]);
-  uint32_t* slots =
-      lent ? new (scratch.data() + size_t{4} * nodes * parts) uint32_t[running] : own_slots.get();
+  // Left uninitialised: the scatter writes every entry, so its threads, not a serial zero fill,
+  // are the first to touch these pages (24 bytes per hex, the largest array of the checker).
+  std::unique_ptr<uint32_t[]> slots(new uint32_t[running]);
   parallel_chunks(parts, parts, 1, [&](int64_t p, int64_t, int64_t) {
-    const std::span<uint32_t> cursor = offsets[p];
+    std::vector<uint32_t>& cursor = offsets[p];
     const int32_t last = part_begin(static_cast<int>(p) + 1);
     for (int32_t h = part_begin(static_cast<int>(p)); h < last; ++h) {
       const std::array<int32_t, 6> lowest = hex_face_lowest_nodes(mesh.hexes[h]);
@@ -197,7 +168,8 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
         slots[cursor[lowest[lf]]++] = static_cast<uint32_t>(h) * 6 + lf;
     }
   });
-  const std::span<const uint32_t> bucket_end = offsets.back();
+  const std::vector<uint32_t> bucket_end = std::move(offsets.back());
+  offsets.clear();
 
   HexFaceAdjacency a;
   if (neighbors) a.hex_neighbors.resize(static_cast<size_t>(hexes));
@@ -286,7 +258,7 @@ HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads, bool
       }
     }
   });
-  own_slots.reset();
+  slots.reset();
   for (int64_t c = 0; c < chunks; ++c) {
     a.boundary_faces.insert(a.boundary_faces.end(), boundary[c].begin(), boundary[c].end());
     a.nonmanifold_faces.insert(a.nonmanifold_faces.end(), nonmanifold[c].begin(),

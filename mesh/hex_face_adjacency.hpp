@@ -11,9 +11,7 @@
 /// Two slots are the same face when their four nodes are the same set (as in topology_build).
 
 #include <array>
-#include <cstddef>
 #include <cstdint>
-#include <span>
 #include <vector>
 
 #include "mesh/hex_mesh.hpp"
@@ -50,11 +48,7 @@ struct HexFaceAdjacency {
 /// when the buckets follow each other in order and, within a bucket, the parts do; returns the
 /// total. On up to `threads` threads (block totals, their prefix, then each block); the result
 /// is the same for every thread count. Precondition: the total fits 32 bits.
-uint32_t counting_sort_starts(std::span<const std::span<uint32_t>> counts, int threads);
-
-/// The scratch hex_face_adjacency_build uses when lent that much: 4 bytes per node for each of up
-/// to min(threads, 4) bucket counts, then 24 bytes per hex for the face slots.
-size_t hex_face_adjacency_scratch_bytes(const HexMesh& mesh, int threads);
+uint32_t counting_sort_starts(std::vector<std::vector<uint32_t>>& counts, int threads);
 
 /// Most hexes hex_face_adjacency_build accepts: its slot ids h * 6 + lf are 32-bit.
 inline constexpr int64_t hex_face_adjacency_max_hexes = (int64_t{1} << 32) / 6 - 1;
@@ -64,12 +58,7 @@ inline constexpr int64_t hex_face_adjacency_max_hexes = (int64_t{1} << 32) / 6 -
 /// and non-manifold faces only: 24 bytes per hex less, for a reader's manifold test).
 /// Preconditions: mesh_validate_ids(mesh) holds and mesh.hex_count() <=
 /// hex_face_adjacency_max_hexes (OperationError otherwise).
-/// `scratch` (16-byte aligned), if at least hex_face_adjacency_scratch_bytes(mesh, threads) long,
-/// holds the bucket counts and the face slots instead of fresh arrays: a caller that lends memory
-/// it has already touched (the checker, after its duplicate-node search) saves the first touch
-/// of the largest arrays here, which on a virtual machine whose host backs memory lazily costs
-/// about a third of the matching itself.
 HexFaceAdjacency hex_face_adjacency_build(const HexMesh& mesh, int threads = 1,
-                                          bool neighbors = true, std::span<std::byte> scratch = {});
+                                          bool neighbors = true);
 
 }  // namespace hexrefine

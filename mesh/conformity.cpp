@@ -292,9 +292,10 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box_on_threads(const H
 /// bucketed by a coarse cell (about four points per cell, one counting sort); near pairs share a
 /// cell unless they straddle a cell wall, so only points within the tolerance of a wall also
 /// search the neighbouring cells. The cell size is an irrational multiple of the mean spacing so
-/// structured grids do not put their points on the walls. A crowded cell (a refined region is
-/// far denser than the box's mean) is sorted by x and swept, comparing only pairs within the
-/// tolerance in x: k log k for k points, quadratic only if they share an x within the tolerance.
+/// structured grids do not put their points on the walls. Pairs are compared on float keys first
+/// (below). A crowded cell (a refined region is far denser than the box's mean) is sorted by key
+/// and swept, comparing only pairs within the key tolerance: k log k for k points, quadratic only
+/// if their keys fall within it.
 int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   const int32_t n = mesh.point_count();
   if (n < 2) return 0;
@@ -313,8 +314,11 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   for (int d = 0; d < 3; ++d)
     dims[d] = std::clamp<int64_t>(static_cast<int64_t>((hi[d] - origin[d]) / cell) + 1, 1,
                                   int64_t{1} << 21);
+  // By the reciprocal: a point next to a wall may land in the cell beside its own, and the wall
+  // tests below, made against the cell it landed in, still send it to look across that wall.
+  const double cells_per_unit = 1.0 / cell;
   auto cell_index = [&](double x, int d) {
-    const double k = std::floor((x - origin[d]) / cell);
+    const double k = std::floor((x - origin[d]) * cells_per_unit);
     return k >= 0.0 ? std::min(static_cast<int64_t>(k), dims[d] - 1) : int64_t{0};  // NaN: 0
   };
   auto cell_of = [&](int64_t x, int64_t y, int64_t z) { return (z * dims[1] + y) * dims[0] + x; };
@@ -368,8 +372,9 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   // float: two points within the tolerance have keys within key_tolerance (the projection moves
   // by at most key_slopes x their distance, rounding to float by half a float ulp, at most
   // 2^-24 x key_slopes x extent, each), so pairs are compared on their keys, next to each other in
-  // the cell, and only pairs with close keys read both points (scattered over the mesh). Structured
-  // grids, whose points share coordinates, have no two points with the same key in a cell.
+  // the cell, and only pairs with close keys read both points (scattered over the mesh). The slopes
+  // are irrational so that the points of a structured grid, which share coordinates, do not share
+  // keys.
   const Eigen::Vector3d slopes(1.0, 0.7548776662, 0.5698402910);  // 1, 1/phi_3, 1/phi_3^2
   const double key_slopes = slopes.sum();
   const double key_tolerance =
@@ -518,18 +523,25 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
     for (int64_t h = begin; h < end; ++h)
       for (int32_t v : mesh.hexes[h])
         std::atomic_ref<char>(used[v]).store(1, std::memory_order_relaxed);
-    std::vector<double> scaled_jacobians(static_cast<size_t>(end - begin)),
-        volumes(static_cast<size_t>(end - begin)), edge_ratios(static_cast<size_t>(end - begin));
-    mesh_hex_measures(mesh, static_cast<int32_t>(begin), scaled_jacobians, volumes, edge_ratios);
-    for (int32_t h = static_cast<int32_t>(begin); h < end; ++h) {
-      const double sj = scaled_jacobians[h - begin];
-      s.scaled_jacobian_sum += sj;
-      s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
-      s.volume += volumes[h - begin];
-      s.max_edge_ratio = std::max(s.max_edge_ratio, edge_ratios[h - begin]);
-      ++s.histogram[scaled_jacobian_bin(sj)];
-      if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
-        s.defects.push_back(h);
+    // Measured in blocks whose values fit on the stack (a heap array per chunk would be fresh
+    // memory each time), summed in hex order.
+    constexpr int64_t block = 256;
+    std::array<double, block> scaled_jacobians, volumes, edge_ratios;
+    for (int64_t first = begin; first < end; first += block) {
+      const size_t count = static_cast<size_t>(std::min(block, end - first));
+      mesh_hex_measures(mesh, static_cast<int32_t>(first), {scaled_jacobians.data(), count},
+                        {volumes.data(), count}, {edge_ratios.data(), count});
+      for (size_t k = 0; k < count; ++k) {
+        const int32_t h = static_cast<int32_t>(first + static_cast<int64_t>(k));
+        const double sj = scaled_jacobians[k];
+        s.scaled_jacobian_sum += sj;
+        s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, sj);
+        s.volume += volumes[k];
+        s.max_edge_ratio = std::max(s.max_edge_ratio, edge_ratios[k]);
+        ++s.histogram[scaled_jacobian_bin(sj)];
+        if (sj <= 0.0 && s.inverted++ < static_cast<int64_t>(mesh_check_defect_hex_limit))
+          s.defects.push_back(h);
+      }
     }
   });
   for (const ChunkSums& s : sums)

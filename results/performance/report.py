@@ -401,7 +401,52 @@ def command_section():
     w("")
 
 
+def checker_section():
+    """Issue 32: the checker's rate and the refine command against its refine stage, from
+    experiments/measure_checker.py (checker.json, checker.md) and
+    experiments/checker_same_reports.sh (checker_same_reports.json)."""
+    if not os.path.exists(os.path.join(here, "checker.json")):
+        return
+    c = load("checker.json")
+    w("## The checker at 10 M hexes/s (issue 32)")
+    w("")
+    w(open(os.path.join(here, "checker.md")).read().rstrip("\n"))
+    w("")
+    rates = []
+    for n, size in c["sizes"].items():
+        b = size["bench_checker"]["benchmarks"]
+        two, one = b["bench_check_refined_2_threads"], b["bench_check_refined"]
+        rates.append(f"{n}^3: {two['hexes_per_s'] / 1e6:.1f} M hexes/s on two threads "
+                     f"(CPU {two['cpu_s']['median']:.3f} s), {one['hexes_per_s'] / 1e6:.1f} M/s on "
+                     f"one (CPU {one['cpu_s']['median']:.3f} s, "
+                     f"{one['hexes_per_cpu_s'] / 1e6:.1f} M hexes per CPU second)")
+    w("The checker without a reference (what `hexrefine check` runs), medians: " +
+      "; ".join(rates) + ". `mesh_check` rows: bench_checker (experiments/benchmarks), the mesh")
+    w("in memory, CPU time the process's (both threads); `hexrefine check` rows: the command's")
+    w("check stage from its report (read stage left out). The refine rows: the whole command's")
+    w("wall time by the script's clock around the process, against the refine stage of the same")
+    w("run's report; with two threads the final check runs beside the write (their stage times")
+    w("overlap).")
+    w("")
+    if os.path.exists(os.path.join(here, "checker_same_reports.json")):
+        same = load("checker_same_reports.json")
+        differ = [x["case"] for x in same["cases"] if not x["identical"]]
+        w(f"Same verdicts and counts: `experiments/checker_same_reports.sh` "
+          f"(`checker_same_reports.json`) compares this checker's JSON report with commit "
+          f"`{same['base']}`'s field for field (floats printed with 17 digits) on "
+          f"{len(same['cases'])} cases (both outputs without and with the brick as the "
+          f"reference, every shared mesh): identical except " + ", ".join(differ) +
+          ", the valid meshes the old no-reference test called non-conformal (issue 28).")
+        w("")
+    w(CHECKER_PROSE)
+    w("")
+
+
+CHECKER_PROSE = open(os.path.join(here, "checker_prose.md")).read().rstrip("\n") \
+    if os.path.exists(os.path.join(here, "checker_prose.md")) else ""
+
 command_section()
+checker_section()
 with open(os.path.join(repo, "results", "performance.md"), "w") as f:
     f.write("\n".join(lines))
 print("wrote results/performance.md")

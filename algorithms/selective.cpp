@@ -260,7 +260,8 @@ RefinementPlan SelectivePass::assemble() {
     } else if (role_[h] == kDirectional) {
       const std::vector<TemplateCell>& cells = cells_[directional_index_[h]];
       if (cells.size() == 1 && cells[0].whole) continue;
-      plan.owned.push_back(selective_cells_template(cells, TemplateTag::directional));
+      plan.owned.push_back(selective_cells_template(cells, TemplateTag::directional, cells_refiner_,
+                                                    options_.placement.configuration_table));
       use.tmpl = plan.owned.back().get();
     } else {
       continue;

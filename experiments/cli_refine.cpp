@@ -74,10 +74,13 @@ int refine_run(const CliArgs& a) {
       o.refine.placement.method = PlacementMethod::optimized;
     else if (*p == "untangle")
       o.refine.placement.method = PlacementMethod::untangle;
+    else if (*p == "reference")
+      o.refine.placement.method = PlacementMethod::reference;
     else
       throw InputError(
-          "hexrefine refine: --placement must be trilinear, optimized or untangle, got '" + *p +
-          "'");
+          "hexrefine refine: --placement must be trilinear, reference, optimized or untangle, "
+          "got '" +
+          *p + "'");
   }
   o.smooth = a.flag("--smooth");
   if (const auto r = a.value("--max-edge-ratio")) {
@@ -148,9 +151,10 @@ const CliCommand cli_refine_command = {
          "H-2), transitions (every transition's children, cumulative) or none"},
         {"--no-buffer", "", "ablation: the same as --buffer none"},
         {"--placement", "P",
-         "new nodes: trilinear (the thesis' positions), optimized (default: raise the worst "
-         "scaled Jacobian, untangle) or untangle (trilinear, inverted children untangled: the "
-         "better start for --smooth)"},
+         "new nodes: trilinear (the thesis' positions), reference (the templates' reference "
+         "positions, best on the unit cube, at trilinear's cost), optimized (default: reference, "
+         "then raise the worst scaled Jacobian where a child is still poor, untangle) or untangle "
+         "(reference, inverted children untangled: the start for --smooth)"},
         {"--smooth", "", "smooth the refined region afterwards (checked again)"},
         {"--max-edge-ratio", "R",
          "optimized placement and --smooth give no hex an edge ratio above R or its ratio before "

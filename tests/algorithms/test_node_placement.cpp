@@ -16,6 +16,7 @@
 #include "algorithms/selective.hpp"
 #include "algorithms/sheet.hpp"
 #include "mesh/conformity.hpp"
+#include "mesh/generators.hpp"
 #include "mesh/io.hpp"
 #include "mesh/quality.hpp"
 #include "mesh/selection.hpp"
@@ -268,6 +269,118 @@ TEST(NodePlacement, EdgeRatioCapKeepsTheEdgesTheScaledJacobianAloneCollapses) {
     EXPECT_LE(capped.smoothed_check->max_edge_ratio, 20 * (1 + 1e-9));
     EXPECT_GE(capped.smoothed_check->min_scaled_jacobian, capped.check.min_scaled_jacobian);
   }
+}
+
+RefineOptions placement_options(PlacementMethod method, int threads = 1) {
+  RefineOptions o;
+  o.placement.method = method;
+  o.threads = threads;
+  return o;
+}
+
+TEST(NodePlacement, ReferenceOutputsAreConformalValidOnTheBoundaryForAnyThreadCount) {
+  // The reference positions over seeded target sets on bricks (plain and jittered), both
+  // refiners: every output passes the checker against its input (conformal, no hanging node, no
+  // inverted hex, boundary on the input's), boundary nodes lie on the input's boundary faces,
+  // and 2 or 3 threads give the same mesh bit for bit.
+  int checked = 0;
+  for (double jitter : {0.0, 0.15}) {
+    BrickParams p;
+    p.dims = {7, 6, 5};
+    p.size = {7, 6, 5};
+    p.jitter = jitter;
+    p.seed = 5;
+    const HexMesh m = generate_brick(p);
+    for (const char* select : {"random:0.03,21", "random:0.08,22", "random:0.2,23", "blob:30,24"})
+      for (const char* method : {"selective", "sheet"}) {
+        const std::string what =
+            std::string(select) + " " + method + " jitter " + std::to_string(jitter);
+        const Targets t{select_hexes(m, {select}).hexes};
+        const RefineResult r =
+            refine(refine_method(method), m, t, placement_options(PlacementMethod::reference));
+        const MeshCheckReport c = mesh_check(r.mesh, &m);
+        EXPECT_TRUE(c.valid()) << what;
+        EXPECT_EQ(c.non_conformal_faces, 0) << what;
+        EXPECT_EQ(c.hanging_nodes, 0) << what;
+        EXPECT_LT(boundary_drift(m, r.mesh), 1e-12) << what;
+        EXPECT_EQ(r.stats.placement.active_hexes, 0) << what;
+        for (int threads : {2, 3}) {
+          const RefineResult rt = refine(refine_method(method), m, t,
+                                         placement_options(PlacementMethod::reference, threads));
+          EXPECT_EQ(rt.mesh.hexes, r.mesh.hexes) << what;
+          EXPECT_EQ(rt.mesh.points, r.mesh.points) << what << " threads " << threads;
+        }
+        ++checked;
+      }
+  }
+  EXPECT_EQ(checked, 16);
+}
+
+TEST(NodePlacement, ReferenceIsTrilinearWhereEveryTemplateIsBoxes) {
+  // Full refinement (1-27 on every hex): the boxes keep the thesis' positions, bit for bit.
+  const HexMesh m = fixture_brick(3, 2, 2);
+  Targets all;
+  for (int32_t h = 0; h < m.hex_count(); ++h) all.hexes.push_back(h);
+  EXPECT_EQ(selective_refine(m, all, placement_options(PlacementMethod::reference)).mesh.points,
+            selective_refine(m, all, placement_options(PlacementMethod::trilinear)).mesh.points);
+}
+
+TEST(NodePlacement, OptimizedNeverEndsBelowReference) {
+  // Optimized placement starts from the reference positions and never lowers the worst child
+  // it works on: over seeded target sets on bricks and the shared meshes, both refiners, its
+  // minimum is at least the reference's (and above it where the reference is poor).
+  struct Case {
+    HexMesh mesh;
+    std::string select;
+  };
+  std::vector<Case> cases;
+  BrickParams p;
+  p.dims = {9, 9, 9};
+  p.size = {9, 9, 9};
+  for (const char* select : {"random:0.04,31", "random:0.1,32"})
+    cases.push_back({generate_brick(p), select});
+  p.jitter = 0.25;
+  cases.push_back({generate_brick(p), "random:0.06,33"});
+  cases.push_back({mesh_read(shared_mesh("rockerarm.mesh")), "sphere:0,0,0,5"});
+  cases.push_back({mesh_read(shared_mesh("ellipsoid.mesh")), "blob:40,3"});
+  int raised = 0, checked = 0;
+  for (const Case& c : cases)
+    for (const char* method : {"selective", "sheet"}) {
+      const std::string what = c.select + " " + method;
+      const Targets t{select_hexes(c.mesh, {c.select}).hexes};
+      RefineOptions ro = placement_options(PlacementMethod::reference);
+      ro.allow_inverted = true;  // fixed positions may invert a child of a distorted parent
+      const double reference =
+          mesh_min_scaled_jacobian(refine(refine_method(method), c.mesh, t, ro).mesh);
+      const RefineResult o =
+          refine(refine_method(method), c.mesh, t, placement_options(PlacementMethod::optimized));
+      const double optimized = mesh_min_scaled_jacobian(o.mesh);
+      EXPECT_GE(optimized, reference - 1e-12) << what;
+      EXPECT_TRUE(mesh_check(o.mesh, &c.mesh).valid()) << what;
+      raised += optimized > reference + 1e-3;
+      ++checked;
+    }
+  EXPECT_EQ(checked, 10);
+  EXPECT_GE(raised, 5);
+}
+
+TEST(NodePlacement, ALaterPassProjectsBoundaryNodesOntoTheInputsCurvedSurface) {
+  // Two passes without the buffer on the shared sphere: pass 2 refines pass 1's transition
+  // children, whose boundary faces are pieces of the input's (non-planar) boundary quads that
+  // their own bilinear maps leave. The reference placement projects the new boundary nodes
+  // back onto the input's quads; the thesis' positions stay off them.
+  const HexMesh m = mesh_read(shared_mesh("sphere_conforming.mesh"));
+  const Targets t{select_hexes(m, {"blob:12,9"}).hexes};
+  RefineOptions o = placement_options(PlacementMethod::reference);
+  o.passes = 2;
+  o.buffer = PassBuffer::none;
+  const RefineResult r = selective_refine(m, t, o);
+  const double size = (mesh_bounding_box(m).second - mesh_bounding_box(m).first).norm();
+  EXPECT_LT(boundary_drift(m, r.mesh), 1e-9 * size);
+  EXPECT_TRUE(mesh_check(r.mesh, &m).valid());
+  RefineOptions tri = o;
+  tri.placement.method = PlacementMethod::trilinear;
+  EXPECT_GT(boundary_drift(m, selective_refine(m, t, tri).mesh), 1e-6 * size);
 }
 
 TEST(NodePlacement, RealMeshesRandomTargetsValidOnTheBoundaryAndNeverWorseThanTrilinear) {

@@ -15,7 +15,12 @@
 /// the minimum never drops; the scaled Jacobian is signed, so the same problem untangles.
 ///
 /// Steps of one pass:
-///  0. Start positions (the engine's): in a later pass, a new node on a boundary face or edge of
+///  0. Start positions (the engine's): a parent whose children the reference positions stretch
+///     past the edge-ratio cap (PlacementOptions::max_edge_ratio, or what the exact positions
+///     give the child if more: a 1-13 in a parent three times longer than wide, whose
+///     transition nodes the face rule lifts) gets its new nodes at their exact positions, so the
+///     cap holds from the start (the shared rocker arm's sphere:0,0,0,5: 23.5 otherwise, 14.9
+///     at the thesis' positions). In a later pass, a new node on a boundary face or edge of
 ///     its parent is projected onto the input's boundary patch that holds it
 ///     (ReferenceSlides): the parent's face is a piece of an input patch that its bilinear map
 ///     reproduces only when the patch is planar or the piece is a rectangle of the patch's
@@ -27,9 +32,14 @@
 ///     reference positions are already the best each template does on an undistorted parent
 ///     (a brick's cubes: what is left poor there is where templates meet), so optimisation pays
 ///     where the pass is worst, and is kept to those children and the hexes around them, not
-///     every new node (a 40^3 brick with 3 % random targets: 342 of 319,132 children).
-///     Children of a parallelepiped by a template of boxes equal their parent and are skipped
-///     without evaluating them; the others are evaluated on `threads` threads (parallel.hpp).
+///     every new node (a 40^3 brick with 3 % random targets: 227 of 319,132 children). In a
+///     later pass also the children below PlacementOptions::active_ratio times their parent's
+///     scaled Jacobian times their own on the unit cube (HexTemplate::child_reference_quality):
+///     the parents there are the earlier passes' children, distorted by the templates
+///     themselves, which the reference positions suit least (a 6^3 brick refined twice around
+///     its centre: 0.20 with the band alone, 0.37 with these). Children of a parallelepiped by
+///     a template of boxes equal their parent and are skipped without evaluating them; the
+///     others are evaluated on `threads` threads (parallel.hpp).
 ///  2. Free nodes: the new nodes of active children. From the template node that made each
 ///     (entity and local index in its parent): strictly inside the parent, or on an interior
 ///     face or edge of the refined mesh: free (both sides share the node, so conformity holds);
@@ -92,6 +102,87 @@ struct NodeOrigin {
   int32_t use = -1;
   int16_t plan_node = -1;
 };
+
+/// Step 0 (see the file comment): the parents whose children at the reference positions exceed
+/// the edge-ratio cap (max(cap, what the exact positions give the child)) get every new node of
+/// theirs at its exact position instead, except the nodes an alias gives to an adjusting hex;
+/// a node shared with a neighbour moves for the neighbour too, so the scan repeats (at most
+/// three times) over the parents of the children that changed. Only parents whose template has
+/// reference positions are scanned (boxes keep the exact ones). Returns how many parents.
+int64_t parents_past_cap_to_exact(const PlacementPass& pass, HexMesh& refined, double cap) {
+  if (!(cap > 0)) return 0;
+  const auto& uses = pass.plan.uses;
+  const int32_t old_nodes = pass.current.point_count();
+  std::vector<uint8_t> scan(uses.size(), 0), exact(uses.size(), 0);
+  for (size_t u = 0; u < uses.size(); ++u) scan[u] = !uses[u].tmpl->reference.empty();
+  std::unordered_map<NodeKey, bool, NodeKeyHash> aliased;
+  for (const NodeAlias& a : pass.plan.aliases) aliased[a.from] = true;
+  // Per new node, the uses whose children hold it (to rescan them when it moves).
+  int64_t reverted = 0;
+  for (int round = 0; round < 3; ++round) {
+    std::vector<int32_t> marked;
+    for (size_t u = 0; u < uses.size(); ++u) {
+      if (!scan[u] || exact[u]) continue;
+      const TemplatePlan& plan = uses[u].tmpl->plans[uses[u].symmetry];
+      const HexCorners parent = hex_points(pass.current, index_of(uses[u].hex));
+      for (size_t c = 0; c < plan.children.size(); ++c) {
+        const int32_t child = pass.first_child[u] + static_cast<int32_t>(c);
+        const double now = hex_edge_ratio(hex_points(refined, child));
+        if (now <= cap) continue;
+        HexCorners at_exact;
+        for (int k = 0; k < 8; ++k) {
+          const TemplatePlanNode& n = plan.nodes[plan.children[c][k]];
+          at_exact[k] = n.entity == CubeEntity::corner ? parent[n.local] : Eigen::Vector3d::Zero();
+          if (n.entity != CubeEntity::corner)
+            for (int v = 0; v < 8; ++v) at_exact[k] += n.weight[v] * parent[v];
+        }
+        if (now > hex_edge_ratio_cap(at_exact, cap)) {
+          marked.push_back(static_cast<int32_t>(u));
+          break;
+        }
+      }
+    }
+    if (marked.empty()) break;
+    std::fill(scan.begin(), scan.end(), 0);
+    std::vector<int32_t> moved;
+    for (int32_t u : marked) {
+      exact[u] = 1;
+      ++reverted;
+      const TemplatePlan& plan = uses[u].tmpl->plans[uses[u].symmetry];
+      const int32_t h = index_of(uses[u].hex);
+      const HexCorners parent = hex_points(pass.current, h);
+      for (size_t c = 0; c < plan.children.size(); ++c)
+        for (int k = 0; k < 8; ++k) {
+          const TemplatePlanNode& n = plan.nodes[plan.children[c][k]];
+          const int32_t node = refined.hexes[pass.first_child[u] + static_cast<int32_t>(c)][k];
+          if (node < old_nodes || n.entity == CubeEntity::corner) continue;
+          if (!aliased.empty() && !n.off_grid && n.entity != CubeEntity::interior &&
+              aliased.count(node_key_at(pass.current, pass.topology, uses[u].hex, n.param)))
+            continue;
+          Eigen::Vector3d x = Eigen::Vector3d::Zero();
+          for (int v = 0; v < 8; ++v) x += n.weight[v] * parent[v];
+          if (x == refined.points[node]) continue;
+          refined.points[node] = x;
+          if (n.entity != CubeEntity::interior) moved.push_back(node);
+        }
+    }
+    if (moved.empty()) break;
+    // The parents around the nodes that moved are scanned again.
+    std::sort(moved.begin(), moved.end());
+    for (size_t u = 0; u < uses.size(); ++u) {
+      if (exact[u] || uses[u].tmpl->reference.empty()) continue;
+      const int32_t first = pass.first_child[u];
+      const int32_t count = static_cast<int32_t>(uses[u].tmpl->children.size());
+      for (int32_t c = first; c < first + count && !scan[u]; ++c)
+        for (int32_t v : refined.hexes[c])
+          if (std::binary_search(moved.begin(), moved.end(), v)) {
+            scan[u] = 1;
+            break;
+          }
+    }
+  }
+  return reverted;
+}
 
 /// Step 0 (see the file comment): the new nodes on a boundary face or edge of their parent,
 /// each once, projected onto the nearest input patch (or patch side) of the input hexes around
@@ -320,7 +411,9 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
   const auto& uses = pass.plan.uses;
   auto original = [&](int32_t h) { return pass.original_of.empty() ? h : pass.original_of[h]; };
 
-  // 0. A later pass: boundary new nodes onto the input's boundary patches.
+  // 0. Parents the reference positions stretch past the cap at their exact positions; in a
+  // later pass, boundary new nodes onto the input's boundary patches.
+  stats.exact_parents += parents_past_cap_to_exact(pass, refined, options.max_edge_ratio);
   if (pass.input_nodes < old_nodes) boundary_nodes_project(pass, refined);
   if (options.method == PlacementMethod::reference) return {};
 
@@ -364,12 +457,16 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
   double worst_positive = 1;
   for (double w : chunk_worst) worst_positive = std::min(worst_positive, w);
   const double top = (1 + options.active_band) * worst_positive;
+  const bool later = pass.input_nodes < old_nodes;
   for (int32_t u : evaluated) {
     const int32_t first = pass.first_child[u];
     const int32_t count = static_cast<int32_t>(uses[u].tmpl->children.size());
+    const std::vector<double>& unit_cube = uses[u].tmpl->child_reference_quality;
     for (int32_t c = first; c < first + count; ++c) {
       const double q = quality[c];
-      const bool poor = options.method != PlacementMethod::untangle && q < top;
+      const bool poor = options.method != PlacementMethod::untangle &&
+                        (q < top || (later && q < options.active_ratio * parent_quality[u] *
+                                                      unit_cube[c - first]));
       if (!poor && q > 0) continue;
       active.push_back(c);
       active_use.push_back(u);
@@ -532,7 +629,6 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
     }
   }
   stats.free_nodes += static_cast<int64_t>(problem.nodes.size());
-
   node_problem_connect(problem, refined, candidates);
 
   NodeOptimizerOptions optimizer;

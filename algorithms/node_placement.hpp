@@ -55,9 +55,13 @@ struct PlacementOptions {
   /// active_band) times the pass's worst positive child's, or not positive (>= 0): the
   /// reference positions already are the best each template can do on an undistorted parent,
   /// so optimisation pays where the pass is worst, and the band keeps it to those children and
-  /// the hexes around them (0.25: the 40^3 brick's 3 % random targets, 319,132 hexes: 342
+  /// the hexes around them (0.25: the 40^3 brick's 3 % random targets, 319,132 hexes: 227
   /// children; results/placement.md).
   double active_band = 0.25;
+  /// In a later pass (whose parents are the earlier passes' children) a child is also worked on
+  /// when its scaled Jacobian is below active_ratio times its parent's times its own on the
+  /// unit cube at the reference positions (HexTemplate::child_reference_quality) (in (0, 1]).
+  double active_ratio = 0.9;
   int max_sweeps = 8;  ///< >= 0: Gauss-Seidel max-min sweeps over the active nodes, worst first
   /// >= 0: sweeps of the smooth phase first (NodeOptimizerOptions::smooth_sweeps).
   int smooth_sweeps = 0;
@@ -75,8 +79,8 @@ struct PlacementOptions {
   /// from those).
   bool configuration_table = true;
 };
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementOptions, method, active_band, max_sweeps,
-                                                smooth_sweeps, layers, joint_iterations,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementOptions, method, active_band, active_ratio,
+                                                max_sweeps, smooth_sweeps, layers, joint_iterations,
                                                 max_edge_ratio, configuration_table)
 
 struct PlacementStats {
@@ -85,15 +89,19 @@ struct PlacementStats {
   int64_t nodes_moved = 0;   ///< of those, the ones that moved
   int64_t inverted_before = 0;  ///< children inverted at their trilinear positions
   int64_t untangled = 0;        ///< of those, the ones placement made valid
-  int sweeps = 0;               ///< sweeps carried out (largest over the passes)
-  int joint_iterations = 0;     ///< joint ascent iterations (all passes)
+  /// Parents whose new nodes start at their exact positions because the reference positions
+  /// stretch a child past the edge-ratio cap (node_placement.cpp, step 0).
+  int64_t exact_parents = 0;
+  int sweeps = 0;            ///< sweeps carried out (largest over the passes)
+  int joint_iterations = 0;  ///< joint ascent iterations (all passes)
   /// Minimum scaled Jacobian over the active children before and after (1 if none).
   double min_before = 1, min_after = 1;
   double seconds = 0;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementStats, active_hexes, free_nodes,
-                                                nodes_moved, inverted_before, untangled, sweeps,
-                                                joint_iterations, min_before, min_after, seconds)
+                                                nodes_moved, inverted_before, untangled,
+                                                exact_parents, sweeps, joint_iterations, min_before,
+                                                min_after, seconds)
 
 /// The boundary of the input of a refinement (before its first pass) as bilinear patches: where
 /// boundary nodes stay whatever the pass. Patch p is a boundary face of the input, its corners in

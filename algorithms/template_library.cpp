@@ -483,6 +483,15 @@ void template_compile(HexTemplate& t, int symmetry_count) {
     throw OperationError(std::string("template ") + template_tag_name(t.tag) + ": " +
                          std::to_string(t.reference.size()) + " reference positions for " +
                          std::to_string(t.nodes.size()) + " nodes");
+  t.child_reference_quality.clear();
+  for (const auto& child : t.children) {
+    HexCorners x;
+    for (int k = 0; k < 8; ++k) {
+      const auto& r = template_node_reference(t, static_cast<size_t>(child[k]));
+      x[k] = Eigen::Vector3d(r[0], r[1], r[2]);
+    }
+    t.child_reference_quality.push_back(hex_scaled_jacobian(x));
+  }
   t.plans.assign(static_cast<size_t>(symmetry_count), {});
   for (int sym = 0; sym < symmetry_count; ++sym) {
     const CubeSymmetry& s = cube_symmetries()[sym];

@@ -112,6 +112,10 @@ struct HexTemplate {
   /// or face of the cube is where template_reference.hpp's rule for that edge's or face's
   /// subdivision puts it (so two hexes sharing it agree); a node inside the cube is free.
   std::vector<std::array<double, 3>> reference;
+  /// Per child: its scaled Jacobian on the unit cube with every node at its reference position
+  /// (template_compile): what the child is on an undistorted parent (node_placement.cpp's
+  /// yardstick in a later pass, whose parents are the earlier passes' children).
+  std::vector<double> child_reference_quality;
   /// Per cube symmetry: the compiled template (template_compile); the standard templates have
   /// all 48, a template made for one hex (plan-owned) only symmetry 0.
   std::vector<TemplatePlan> plans;
@@ -127,7 +131,8 @@ inline const std::array<double, 3>& template_node_reference(const HexTemplate& t
 /// Fills tmpl.child_axis.
 void template_compute_child_axes(HexTemplate& tmpl);
 
-/// Fills tmpl.plans for symmetries 0 .. symmetry_count - 1 (48: all). Throws OperationError if a
+/// Fills tmpl.plans for symmetries 0 .. symmetry_count - 1 (48: all) and
+/// tmpl.child_reference_quality. Throws OperationError if a
 /// node off the exact grid is not strictly inside the cube (it could not be shared with a
 /// neighbour), or if tmpl.reference is neither empty nor one position per node.
 void template_compile(HexTemplate& tmpl, int symmetry_count = 48);

@@ -234,11 +234,7 @@ std::unique_ptr<HexTemplate> selective_cells_template(const std::vector<Template
     t->children.push_back(child);
   }
   if (!moved) t->reference.clear();
-  if (configuration_table) {
-    // The table is found by the configuration's exact positions (plans[0]).
-    template_compile(*t, 1);
-    if (!template_reference_from_configurations(*t)) return t;
-  }
+  if (configuration_table) template_reference_from_configurations(*t);
   template_compile(*t, 1);
   return t;
 }

@@ -294,8 +294,8 @@ std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
     t.children.push_back(child);
     c->positive = c->positive && hex_corners_positive(hex_points(cube, h));
   }
+  if (configuration_table) template_reference_from_configurations(t);
   template_compile(t, 1);
-  if (configuration_table && template_reference_from_configurations(t)) template_compile(t, 1);
   composite_face_hashes(t, c->face_hash);
   return c;
 }

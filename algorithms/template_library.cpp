@@ -484,6 +484,7 @@ void template_compile(HexTemplate& t, int symmetry_count) {
                          std::to_string(t.reference.size()) + " reference positions for " +
                          std::to_string(t.nodes.size()) + " nodes");
   t.child_reference_quality.clear();
+  t.reference_edge_ratio = 1;
   for (const auto& child : t.children) {
     HexCorners x;
     for (int k = 0; k < 8; ++k) {
@@ -491,6 +492,7 @@ void template_compile(HexTemplate& t, int symmetry_count) {
       x[k] = Eigen::Vector3d(r[0], r[1], r[2]);
     }
     t.child_reference_quality.push_back(hex_scaled_jacobian(x));
+    t.reference_edge_ratio = std::max(t.reference_edge_ratio, hex_edge_ratio(x));
   }
   t.plans.assign(static_cast<size_t>(symmetry_count), {});
   for (int sym = 0; sym < symmetry_count; ++sym) {

@@ -116,6 +116,9 @@ struct HexTemplate {
   /// (template_compile): what the child is on an undistorted parent (node_placement.cpp's
   /// yardstick in a later pass, whose parents are the earlier passes' children).
   std::vector<double> child_reference_quality;
+  /// The largest edge ratio of a child on the unit cube at the reference positions
+  /// (template_compile).
+  double reference_edge_ratio = 1;
   /// Per cube symmetry: the compiled template (template_compile); the standard templates have
   /// all 48, a template made for one hex (plan-owned) only symmetry 0.
   std::vector<TemplatePlan> plans;

@@ -407,31 +407,61 @@ void template_reference_from_table(HexTemplate& t) {
 }
 
 TemplateConfiguration template_configuration(const HexTemplate& t) {
-  const TemplatePlan& plan = t.plans.at(0);
+  // Exact positions are multiples of 1 / template_param_unit, which rounding recovers; a node
+  // nested deeper rounds to the nearest (the same every time it is met).
   const size_t n = t.nodes.size();
   std::vector<Code> code(n);
-  for (size_t i = 0; i < n; ++i) {
-    if (!plan.nodes[i].off_grid) {
-      code[i] = plan.nodes[i].param;
-    } else {
-      for (int k = 0; k < 3; ++k)
-        code[i][k] = std::llround(t.nodes[i].ref[k] * double(template_param_unit));
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k)
+      code[i][k] = std::llround(t.nodes[i].ref[k] * double(template_param_unit));
+  // The frame, a function of the node set alone: first the symmetries that make the mapped
+  // positions' first and second moments per axis (exact integer sums) least, lexicographically
+  // (a handful: O(n) once, then 48 constant-time candidates); among them the one whose
+  // order-independent hash of the mapped positions is least (the first on a tie, which only a
+  // configuration with a symmetry of its own has, whose images are then the same set).
+  using Wide = __int128;
+  std::array<Wide, 3> first{}, second{};
+  for (const Code& c : code)
+    for (int k = 0; k < 3; ++k) {
+      first[k] += c[k];
+      second[k] += Wide(c[k]) * c[k];
+    }
+  const Wide count = static_cast<Wide>(n), unit = template_param_unit;
+  auto moments = [&](const CubeSymmetry& sym) {
+    std::array<Wide, 6> m{};
+    for (int k = 0; k < 3; ++k) {
+      const int a = sym.axis[k];
+      m[k] = sym.flip[k] ? count * unit - first[a] : first[a];
+      m[3 + k] = sym.flip[k] ? count * unit * unit - 2 * unit * first[a] + second[a] : second[a];
+    }
+    return m;
+  };
+  std::array<Wide, 6> least_moments{};
+  std::vector<int> candidates;
+  for (int s = 0; s < 48; ++s) {
+    const std::array<Wide, 6> m = moments(cube_symmetries()[s]);
+    if (candidates.empty() || m < least_moments) {
+      least_moments = m;
+      candidates.assign(1, s);
+    } else if (m == least_moments) {
+      candidates.push_back(s);
     }
   }
-  // The frame: the symmetry whose order-independent hash of the mapped positions is least (the
-  // first on a tie, which a configuration with a symmetry of its own may have).
   TemplateConfiguration out;
-  uint64_t least = 0;
-  for (int s = 0; s < 48; ++s) {
-    uint64_t sum = 0;
-    for (const Code& c : code) {
-      const Code m = symmetry_code(cube_symmetries()[s], c);
-      sum += mix(static_cast<uint64_t>(m[0]) ^
-                 mix(static_cast<uint64_t>(m[1]) ^ mix(static_cast<uint64_t>(m[2]))));
-    }
-    if (s == 0 || sum < least) {
-      least = sum;
-      out.symmetry = static_cast<int8_t>(s);
+  out.symmetry = static_cast<int8_t>(candidates[0]);
+  if (candidates.size() > 1) {
+    uint64_t least = 0;
+    for (size_t k = 0; k < candidates.size(); ++k) {
+      uint64_t sum = 0;
+      for (const Code& c : code) {
+        const Code m = symmetry_code(cube_symmetries()[candidates[k]], c);
+        sum += mix(static_cast<uint64_t>(m[0]) ^
+                   mix(static_cast<uint64_t>(m[1]) ^ mix(static_cast<uint64_t>(m[2]))));
+      }
+      if (k == 0 || sum < least) {
+        least = sum;
+        out.symmetry = static_cast<int8_t>(candidates[k]);
+      }
     }
   }
   const CubeSymmetry& s = cube_symmetries()[out.symmetry];

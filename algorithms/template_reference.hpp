@@ -94,7 +94,8 @@ struct TemplateConfiguration {
   std::vector<int32_t> order;
 };
 
-/// The configuration of a template compiled for symmetry 0 (plans[0]).
+/// The configuration of a template in canonical orientation (its nodes' `ref`; it need not be
+/// compiled).
 TemplateConfiguration template_configuration(const HexTemplate& tmpl);
 
 /// Sets the movable nodes' reference positions of a directional configuration (a plan-owned

@@ -147,13 +147,13 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
     # children optimised; smoothed: sweeps, joint ascent, sweeps), no hex stretched past the
     # default edge-ratio cap of 20.
     assert report_one["check"]["min_scaled_jacobian"] == 0.11023223760640442
-    assert report_two["smoothing"]["check"]["min_scaled_jacobian"] == 0.4448602214607803
+    assert report_two["smoothing"]["check"]["min_scaled_jacobian"] == 0.4051133683514108
     for report in (report_one["check"], report_two["smoothing"]["check"]):
         assert 19.9 < report["max_edge_ratio"] <= 20 * (1 + 1e-9)
     # Without the cap, the scaled Jacobian alone: higher minima by collapsed edges.
     _, uncapped = hexrefine.refine(mesh, "sphere:0,0,0,5", max_edge_ratio=0)
     assert uncapped["check"]["min_scaled_jacobian"] == 0.11783137589340247
-    assert uncapped["check"]["max_edge_ratio"] > 4000
+    assert uncapped["check"]["max_edge_ratio"] > 1000
     with pytest.raises(ValueError, match="max_edge_ratio"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", max_edge_ratio=0.5)
 

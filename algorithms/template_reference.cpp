@@ -802,6 +802,11 @@ void template_reference_add_configurations(TemplateReferenceTable& table,
     table.configurations.push_back(std::move(out));
   }
   // Only the configurations whose optimisation raised the minimum need a row.
+  for (const TemplateReferenceConfiguration& c : table.configurations) {
+    const bool raised = c.reference_min > c.composed_min + 1e-9 && !c.movable.empty();
+    table.corpus_worst_min =
+        std::min(table.corpus_worst_min, raised ? c.reference_min : c.composed_min);
+  }
   std::erase_if(table.configurations, [](const TemplateReferenceConfiguration& c) {
     return !(c.reference_min > c.composed_min + 1e-9) || c.movable.empty();
   });
@@ -831,6 +836,7 @@ std::string template_reference_table_source(const TemplateReferenceTable& table)
   o << "constexpr const char* table_corpus = \"" << table.corpus << "\";\n";
   o << "constexpr int64_t table_corpus_hexes = " << table.corpus_hexes << ";\n";
   o << "constexpr int64_t table_corpus_configurations = " << table.corpus_configurations << ";\n";
+  o << "constexpr double table_corpus_worst_min = " << number(table.corpus_worst_min) << ";\n";
   std::vector<std::array<double, 3>> positions;
   o << "constexpr std::array<TableTemplate, " << table.templates.size() << "> table_templates{{\n";
   for (const TemplateReferenceEntry& e : table.templates) {
@@ -871,6 +877,7 @@ TemplateReferenceTable template_reference_committed() {
   table.corpus = table_corpus;
   table.corpus_hexes = table_corpus_hexes;
   table.corpus_configurations = table_corpus_configurations;
+  table.corpus_worst_min = table_corpus_worst_min;
   for (const TableTemplate& row : table_templates) {
     TemplateReferenceEntry e;
     e.tag = row.tag;

@@ -158,8 +158,10 @@ struct TemplateReferenceTable {
   std::vector<TemplateReferenceConfiguration> configurations;  ///< ascending hash
   std::string corpus;  ///< what the configurations were collected from
   /// The corpus' directional hexes and their distinct configurations (those whose optimisation
-  /// raised the minimum have a row).
+  /// raised the minimum have a row), and the worst unit-cube minimum over all of them at the
+  /// positions the library gives them (the table's, or the composed ones).
   int64_t corpus_hexes = 0, corpus_configurations = 0;
+  double corpus_worst_min = 1;
 };
 
 /// The offline optimisation of the standard templates (see template_reference.cpp): the face

@@ -44,14 +44,14 @@ constexpr std::array<const HexTemplate* (*)(), 8> standard = {
     [] { return &template_1_3(); },         [] { return &template_1_3_adjust1(); },
     [] { return &template_1_3_adjust2(); }, [] { return &template_1_9(); }};
 
-/// What stops a template below the bound of its own rule, in words.
+/// What stops a template where its reference positions leave it, in words.
 std::string template_constraint(const TemplateReferenceEntry& e) {
-  if (e.own_rule_min > e.reference_min + 1e-6)
+  if (e.own_rule_min > e.reference_min + 1e-3)
     return "the 1-4 face rule shared with 1-13, 1-5, 1-4";
   if (e.reference_min >= 1 - 1e-12) return "none (boxes)";
   if (e.tag == TemplateTag::t1_3_adjust1 || e.tag == TemplateTag::t1_3_adjust2)
-    return "adjustment nodes shared with the neighbours (their rule: the L-shaped case)";
-  return "its edges and 1-9 faces at thirds (shared with 1-27)";
+    return "adjustment nodes placed for the neighbours (the L-shaped case's rule)";
+  return "its own: the parent's corners fixed";
 }
 
 /// The corpus of the directional configurations: generated meshes and seeded target sets,
@@ -156,6 +156,7 @@ int templates_run(const CliArgs& a) {
     for (const auto& t : composites) pointers.push_back(t.get());
     table.configurations.clear();
     table.corpus_hexes = table.corpus_configurations = 0;
+    table.corpus_worst_min = 1;
     template_reference_add_configurations(table, pointers, counts);
     template_reference_install(table);
     std::cout << "directional configurations: " << table.corpus_configurations << " distinct in "
@@ -223,11 +224,13 @@ int templates_run(const CliArgs& a) {
     worst_reference = std::min(worst_reference, c.reference_min);
     seen += c.seen;
   }
-  std::cout << "directional configurations in the table: " << used.configurations.size() << " of "
-            << used.corpus_configurations << " in the corpus' " << used.corpus_hexes
+  std::cout << "directional configurations in the table: " << used.configurations.size()
+            << " of " << used.corpus_configurations << " in the corpus' " << used.corpus_hexes
             << " directional hexes (" << seen
             << " of them); worst unit-cube minimum of those composed " << worst_composed
-            << ", at the table's positions " << worst_reference << "\n";
+            << ", at the table's positions " << worst_reference
+            << "; of every configuration of the corpus at its positions "
+            << used.corpus_worst_min << "\n";
   if (report) {
     nlohmann::json out = {
         {"templates", list},
@@ -240,6 +243,7 @@ int templates_run(const CliArgs& a) {
           {"corpus_configurations", used.corpus_configurations},
           {"corpus_hexes", used.corpus_hexes},
           {"corpus_hexes_in_table", seen},
+          {"corpus_worst_min", used.corpus_worst_min},
           {"corpus", used.corpus},
           {"worst_composed_min", worst_composed},
           {"worst_reference_min", worst_reference}}}};

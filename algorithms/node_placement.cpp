@@ -400,7 +400,9 @@ std::string_view placement_method_name(PlacementMethod m) {
 }
 
 TemplatePositions placement_start_positions(PlacementMethod m) {
-  return m == PlacementMethod::trilinear ? TemplatePositions::exact : TemplatePositions::reference;
+  return m == PlacementMethod::trilinear || m == PlacementMethod::untangle
+             ? TemplatePositions::exact
+             : TemplatePositions::reference;
 }
 
 BoundaryReference boundary_reference_build(const HexMesh& input, const HexTopology& t) {

@@ -25,11 +25,15 @@ enum class PlacementMethod : uint8_t {
   /// raise the worst scaled Jacobian around them, inverted children untangled first
   /// (node_placement.cpp).
   optimized,
-  /// Reference positions, and only the new nodes of inverted children move, until those are
-  /// valid (no joint ascent): the start for smoothing, which then raises the quality from
-  /// positions that have not yet used up the edge-ratio room (PlacementOptions::max_edge_ratio).
-  /// Over the real-mesh study's cases smoothing ends higher from here than from `optimized`
-  /// (results/smooth_start.md, measured from the trilinear positions).
+  /// The thesis' trilinear positions, and only the new nodes of inverted children move, until
+  /// those are valid (no joint ascent): the start for smoothing, which then raises the quality
+  /// from positions that have not yet used up the edge-ratio room
+  /// (PlacementOptions::max_edge_ratio). Over the real-mesh study's cases smoothing ends higher
+  /// from here than from `optimized` (results/smooth_start.md). Not from the reference
+  /// positions, although issue 29 asked for it: smoothed from them, 14 cases of the shared
+  /// meshes (both refiners) ended lower on 7 (rockerarm `sphere:0,0,0,5` selective 0.459 ->
+  /// 0.367, bunny and cube-minus-sphere 2 % random 0.21 -> 0.09), higher on 4, equal on 3
+  /// (docs/placement-and-smoothing.md): the reference positions spend the room smoothing needs.
   untangle,
   /// Every new node at the parent's trilinear map of the template's reference position
   /// (template_reference.hpp: the positions that maximise the worst child on the unit cube),
@@ -46,7 +50,8 @@ NLOHMANN_JSON_SERIALIZE_ENUM(PlacementMethod, {{PlacementMethod::trilinear, "tri
 std::string_view placement_method_name(PlacementMethod m);
 
 /// Where the engine puts the new nodes before placement moves any: the templates' exact
-/// positions for `trilinear`, their reference positions for every other method.
+/// positions for `trilinear` and `untangle`, their reference positions for `reference` and
+/// `optimized`.
 TemplatePositions placement_start_positions(PlacementMethod m);
 
 struct PlacementOptions {

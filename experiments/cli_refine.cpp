@@ -157,7 +157,7 @@ const CliCommand cli_refine_command = {
          "new nodes: trilinear (the thesis' positions), reference (the templates' reference "
          "positions, best on the unit cube, at trilinear's cost), optimized (the default without "
          "--smooth: reference, then raise the worst scaled Jacobian where a child is still poor, "
-         "untangle) or untangle (reference, inverted children untangled: the default with "
+         "untangle) or untangle (trilinear, inverted children untangled: the default with "
          "--smooth, the better start for it)"},
         {"--smooth", "",
          "smooth the refined region afterwards (checked again; starts from --placement untangle "

@@ -312,7 +312,7 @@ PYBIND11_MODULE(_hexrefine, m) {
       "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647}, "max_edge_ratio"_a = 20.0,
       "Refines `targets` (hex ids, or selection specs) by `method` through the pipeline: plan, "
       "apply, place the new nodes (placement 'optimized', the thesis' 'trilinear', 'reference': "
-      "the templates' reference positions, or 'untangle': reference with inverted children "
+      "the templates' reference positions, or 'untangle': trilinear with inverted children "
       "untangled, the better start for smooth=True; none given: 'untangle' with smooth=True, else "
       "'optimized'), check "
       "against the input, optionally smooth and check again. Returns (mesh, report): the mesh "

@@ -370,10 +370,12 @@ std::vector<uint8_t> nodes_moved_and_around(const HexMesh& mesh, const NodeProbl
 
 SweepsAndAscentStats nodes_sweep_and_ascend(HexMesh& mesh, const NodeProblem& problem,
                                             NodeOptimizerOptions sweeps,
-                                            const JointAscentOptions& joint) {
+                                            const JointAscentOptions& joint, double ascend_below) {
   SweepsAndAscentStats stats;
-  stats.sweeps = nodes_optimize(mesh, problem, sweeps).sweeps;
+  const NodeOptimizerStats first = nodes_optimize(mesh, problem, sweeps);
+  stats.sweeps = first.sweeps;
   if (sweeps.max_sweeps <= 0 || joint.max_iterations <= 0) return stats;
+  if (!(first.min_after < ascend_below)) return stats;
   std::vector<Vec3> before;
   before.reserve(problem.nodes.size());
   for (int32_t v : problem.nodes) before.push_back(mesh.points[v]);

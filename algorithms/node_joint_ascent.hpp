@@ -8,6 +8,7 @@
 /// node_joint_ascent.cpp.
 
 #include <cstdint>
+#include <limits>
 
 #include "algorithms/node_optimizer.hpp"
 #include "mesh/hex_mesh.hpp"
@@ -61,13 +62,15 @@ struct SweepsAndAscentStats {
 };
 
 /// What node placement and smoothing both do: nodes_optimize with `sweeps`; then, unless
-/// sweeps.max_sweeps or joint.max_iterations is 0, nodes_ascend_jointly; and if that raised the
+/// sweeps.max_sweeps or joint.max_iterations is 0 or the sweeps left the minimum over the
+/// problem's hexes at or above `ascend_below`, nodes_ascend_jointly; and if that raised the
 /// minimum, nodes_optimize again, its first sweep visiting only the nodes the ascent moved and
 /// those sharing a hex with them (the others are where the first round left them). The joint
 /// ascent leaves the sliding nodes where they were and its worst hexes balanced: node by node,
-/// the sweeps can raise the minimum again from there.
-SweepsAndAscentStats nodes_sweep_and_ascend(HexMesh& mesh, const NodeProblem& problem,
-                                            NodeOptimizerOptions sweeps,
-                                            const JointAscentOptions& joint);
+/// the sweeps can raise the minimum again from there. (`ascend_below`: node placement's band,
+/// whose goal the sweeps may reach alone.)
+SweepsAndAscentStats nodes_sweep_and_ascend(
+    HexMesh& mesh, const NodeProblem& problem, NodeOptimizerOptions sweeps,
+    const JointAscentOptions& joint, double ascend_below = std::numeric_limits<double>::infinity());
 
 }  // namespace hexrefine

@@ -18,31 +18,58 @@
 namespace hexrefine {
 
 enum class PlacementMethod : uint8_t {
-  /// Every new node stays at the parent's trilinear map of the template's reference position
-  /// (the thesis' placement: its tables are reproduced with it).
+  /// Every new node stays at the parent's trilinear map of the template's exact position (the
+  /// thesis' placement: its tables are reproduced with it).
   trilinear,
-  /// Trilinear first, then the new nodes around poor children move to raise the worst scaled
-  /// Jacobian around them, inverted children untangled first (node_placement.cpp).
+  /// Reference positions first, then the new nodes around the children still poor move to
+  /// raise the worst scaled Jacobian around them, inverted children untangled first
+  /// (node_placement.cpp).
   optimized,
-  /// Trilinear, and only the new nodes of inverted children move, until those are valid (no
-  /// joint ascent): the start for smoothing, which then raises the quality from positions
-  /// that have not yet used up the edge-ratio room (PlacementOptions::max_edge_ratio). Over
-  /// the real-mesh study's cases smoothing ends higher from here than from `optimized`
-  /// (results/smooth_start.md).
+  /// The thesis' trilinear positions, and only the new nodes of inverted children move, until
+  /// those are valid (no joint ascent): the start for smoothing, which then raises the quality
+  /// from positions that have not yet used up the edge-ratio room
+  /// (PlacementOptions::max_edge_ratio). Over the real-mesh study's cases smoothing ends higher
+  /// from here than from `optimized` (results/smooth_start.md). Not from the reference
+  /// positions, although issue 29 asked for it: smoothed from them, 14 cases of the shared
+  /// meshes (both refiners) ended lower on 7 (rockerarm `sphere:0,0,0,5` selective 0.459 ->
+  /// 0.367, bunny and cube-minus-sphere 2 % random 0.21 -> 0.09), higher on 4, equal on 3
+  /// (docs/placement-and-smoothing.md): the reference positions spend the room smoothing needs.
   untangle,
+  /// Every new node at the parent's trilinear map of the template's reference position
+  /// (template_reference.hpp: the positions that maximise the worst child on the unit cube),
+  /// at the cost of `trilinear`; in a later pass, boundary nodes projected onto the input's
+  /// boundary patches.
+  reference,
 };
 NLOHMANN_JSON_SERIALIZE_ENUM(PlacementMethod, {{PlacementMethod::trilinear, "trilinear"},
                                                {PlacementMethod::optimized, "optimized"},
-                                               {PlacementMethod::untangle, "untangle"}})
+                                               {PlacementMethod::untangle, "untangle"},
+                                               {PlacementMethod::reference, "reference"}})
 
-/// "trilinear" / "optimized" / "untangle".
+/// "trilinear" / "optimized" / "untangle" / "reference".
 std::string_view placement_method_name(PlacementMethod m);
+
+/// Where the engine puts the new nodes before placement moves any: the templates' exact
+/// positions for `trilinear` and `untangle`, their reference positions for `reference` and
+/// `optimized`.
+TemplatePositions placement_start_positions(PlacementMethod m);
 
 struct PlacementOptions {
   PlacementMethod method = PlacementMethod::optimized;
-  /// A child is worked on when its scaled Jacobian is below active_ratio times its parent's
-  /// (in (0, 1]): children of a parallelepiped by a box template (1-27, 1-9, 1-3) equal their
-  /// parent and are left alone, transition children (1-13: 4/13 of the parent) are not.
+  /// A child is worked on when its scaled Jacobian is below (1 + active_band) times the worst
+  /// positive child's of the pass, or not positive (>= 0): the reference positions already are
+  /// the best each template does on an undistorted parent, so optimisation pays where the pass
+  /// is worst, and the band keeps it to those children and the hexes around them. In rounds: the
+  /// first from the start positions; then, while the worst child rises, the band around the new
+  /// worst, as long as each round fits what is left of a budget of max(active_floor,
+  /// active_share x the pass's new hexes) children (a 40^3 brick with 3 % random targets: one
+  /// round, 227 of 319,132 children; the same brick jittered: 552 in four; results/placement.md).
+  double active_band = 0.25;
+  double active_share = 0.005;
+  double active_floor = 0;
+  /// In a later pass (whose parents are the earlier passes' children) a child is also worked on
+  /// when its scaled Jacobian is below active_ratio times its parent's times its own on the
+  /// unit cube at the reference positions (HexTemplate::child_reference_quality) (in (0, 1]).
   double active_ratio = 0.9;
   int max_sweeps = 8;  ///< >= 0: Gauss-Seidel max-min sweeps over the active nodes, worst first
   /// >= 0: sweeps of the smooth phase first (NodeOptimizerOptions::smooth_sweeps).
@@ -52,13 +79,19 @@ struct PlacementOptions {
   /// >= 0: L-BFGS iterations of the joint ascent after the sweeps (node_joint_ascent.hpp; 0:
   /// none), then the sweeps again if it raised the minimum.
   int joint_iterations = 100;
-  /// No move gives a hex an edge ratio above max(max_edge_ratio, its ratio at the trilinear
+  /// No move gives a hex an edge ratio above max(max_edge_ratio, its ratio at the start
   /// positions) (NodeOptimizerOptions::max_edge_ratio; <= 0: no cap, the scaled Jacobian alone).
   double max_edge_ratio = 20;
+  /// Directional hexes take their movable nodes' reference positions from the committed table
+  /// of directional configurations where it lists theirs (template_reference.hpp); false: the
+  /// composed positions of their steps alone (`hexrefine templates --optimize` builds the table
+  /// from those).
+  bool configuration_table = true;
 };
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementOptions, method, active_ratio, max_sweeps,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementOptions, method, active_band, active_share,
+                                                active_floor, active_ratio, max_sweeps,
                                                 smooth_sweeps, layers, joint_iterations,
-                                                max_edge_ratio)
+                                                max_edge_ratio, configuration_table)
 
 struct PlacementStats {
   int64_t active_hexes = 0;  ///< children worked on (all passes)
@@ -66,15 +99,19 @@ struct PlacementStats {
   int64_t nodes_moved = 0;   ///< of those, the ones that moved
   int64_t inverted_before = 0;  ///< children inverted at their trilinear positions
   int64_t untangled = 0;        ///< of those, the ones placement made valid
-  int sweeps = 0;               ///< sweeps carried out (largest over the passes)
-  int joint_iterations = 0;     ///< joint ascent iterations (all passes)
+  /// Parents whose new nodes start at their exact positions because the reference positions
+  /// stretch a child past the edge-ratio cap (node_placement.cpp, step 0).
+  int64_t exact_parents = 0;
+  int sweeps = 0;            ///< sweeps carried out (largest over the passes)
+  int joint_iterations = 0;  ///< joint ascent iterations (all passes)
   /// Minimum scaled Jacobian over the active children before and after (1 if none).
   double min_before = 1, min_after = 1;
   double seconds = 0;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PlacementStats, active_hexes, free_nodes,
-                                                nodes_moved, inverted_before, untangled, sweeps,
-                                                joint_iterations, min_before, min_after, seconds)
+                                                nodes_moved, inverted_before, untangled,
+                                                exact_parents, sweeps, joint_iterations, min_before,
+                                                min_after, seconds)
 
 /// The boundary of the input of a refinement (before its first pass) as bilinear patches: where
 /// boundary nodes stay whatever the pass. Patch p is a boundary face of the input, its corners in

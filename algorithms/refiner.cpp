@@ -246,7 +246,8 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
       stats.phase_seconds["plan"] += seconds_since(t);
 
       t = Clock::now();
-      applied = plan_apply(*current, topology, plan, options.threads);
+      applied = plan_apply(*current, topology, plan, options.threads,
+                           placement_start_positions(options.placement.method));
       stats.phase_seconds["apply"] += seconds_since(t);
 
       t = Clock::now();

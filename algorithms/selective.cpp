@@ -260,7 +260,11 @@ RefinementPlan SelectivePass::assemble() {
     } else if (role_[h] == kDirectional) {
       const std::vector<TemplateCell>& cells = cells_[directional_index_[h]];
       if (cells.size() == 1 && cells[0].whole) continue;
-      plan.owned.push_back(selective_cells_template(cells, TemplateTag::directional));
+      // The table's positions are reference positions: the thesis' placement needs none.
+      plan.owned.push_back(
+          selective_cells_template(cells, TemplateTag::directional, cells_refiner_,
+                                   options_.placement.configuration_table &&
+                                       options_.placement.method != PlacementMethod::trilinear));
       use.tmpl = plan.owned.back().get();
     } else {
       continue;

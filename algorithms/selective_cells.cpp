@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "algorithms/template_reference.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
 
@@ -35,12 +36,14 @@ std::array<double, 3> param_ref(const TemplateParam& p) {
   return {double(p[0]) / kUnit, double(p[1]) / kUnit, double(p[2]) / kUnit};
 }
 
-// The template position p (in the cell's frame) mapped into the hex's cube by the cell's corners.
-std::array<double, 3> cell_map(const TemplateCell& cell, const std::array<double, 3>& p) {
+// The template position p (in the cell's frame) mapped into the hex's cube by the cell's corners
+// `corners` (its exact `ref` or its reference `place`).
+std::array<double, 3> cell_map(const std::array<std::array<double, 3>, 8>& corners,
+                               const std::array<double, 3>& p) {
   const std::array<double, 8> w = hex_trilinear_weights(p);
   std::array<double, 3> out{0, 0, 0};
   for (int v = 0; v < 8; ++v)
-    for (int k = 0; k < 3; ++k) out[k] += w[v] * cell.ref[v][k];
+    for (int k = 0; k < 3; ++k) out[k] += w[v] * corners[v][k];
   return out;
 }
 
@@ -66,6 +69,7 @@ TemplateCell CellRefiner::cell_whole(int32_t hex) const {
     for (int k = 0; k < 3; ++k) {
       c.param[v][k] = hex_corner[v][k] * kUnit;
       c.ref[v][k] = hex_corner[v][k];
+      c.place[v][k] = hex_corner[v][k];
     }
     c.key[v] = NodeKey::corner(NodeId{mesh_.hexes[hex][v]});
   }
@@ -89,6 +93,7 @@ NodeKey CellRefiner::key_of_template_node(const TemplateCell& cell, int symmetry
 bool CellRefiner::alias(const NodeKey& from, const NodeKey& to) {
   if (used_.count(from)) return false;
   const auto [it, inserted] = aliases_.emplace(from, to);
+  if (inserted) alias_targets_.insert(to);
   return inserted || it->second == to;
 }
 
@@ -119,7 +124,7 @@ void CellRefiner::refine(const TemplateCell& cell, const HexTemplate& t, int sym
 
   struct Placed {
     TemplateParam param;
-    std::array<double, 3> ref;
+    std::array<double, 3> ref, place;
     NodeKey key;
     bool exact, aliased;
   };
@@ -128,6 +133,9 @@ void CellRefiner::refine(const TemplateCell& cell, const HexTemplate& t, int sym
     const std::array<double, 3> p = cube_symmetry_apply(s, t.nodes[i].ref);
     Placed& out = placed[i];
     out.aliased = false;
+    // The step's reference position through the cell's reference corners (a corner of the cell
+    // keeps its own below).
+    out.place = cell_map(cell.place, cube_symmetry_apply(s, template_node_reference(t, i)));
     std::array<int64_t, 3> p6{};
     const bool on_grid = to_sixths(p, p6);
     out.exact = on_grid && cell.exact && cell_map_sixths(cell, p6, out.param);
@@ -135,6 +143,7 @@ void CellRefiner::refine(const TemplateCell& cell, const HexTemplate& t, int sym
       const int corner = hex_vertex_at(int(p6[0] / 6), int(p6[1] / 6), int(p6[2] / 6));
       out.param = cell.param[corner];
       out.ref = cell.ref[corner];
+      out.place = cell.place[corner];
       out.key = cell.key[corner];
       out.exact = cell.exact;
       continue;
@@ -145,7 +154,7 @@ void CellRefiner::refine(const TemplateCell& cell, const HexTemplate& t, int sym
       bool interior = true;
       for (int k = 0; k < 3; ++k) interior = interior && p[k] > 1e-12 && p[k] < 1 - 1e-12;
       if (!interior) fail("a node on the cell's boundary is off the exact grid");
-      out.ref = cell_map(cell, p);
+      out.ref = cell_map(cell.ref, p);
       // A key nobody else can name: interior kind, negative b.
       out.key = NodeKey::interior(HexId{h}, {0, 0, 0});
       out.key.b = -1 - off_grid_count_++;
@@ -181,6 +190,7 @@ void CellRefiner::refine(const TemplateCell& cell, const HexTemplate& t, int sym
       const Placed& pl = placed[c[k]];
       out.param[k] = pl.param;
       out.ref[k] = pl.ref;
+      out.place[k] = pl.place;
       out.key[k] = pl.key;
       out.exact = out.exact && pl.exact;
       out.collapsed = out.collapsed || pl.aliased;
@@ -202,19 +212,29 @@ void CellRefiner::refine(const TemplateCell& cell, const HexTemplate& t, int sym
 }
 
 std::unique_ptr<HexTemplate> selective_cells_template(const std::vector<TemplateCell>& cells,
-                                                      TemplateTag tag) {
+                                                      TemplateTag tag, const CellRefiner& refiner,
+                                                      bool configuration_table) {
   auto t = std::make_unique<HexTemplate>();
   t->tag = tag;
   std::unordered_map<NodeKey, int16_t, NodeKeyHash> index;
+  bool moved = false;
   for (const TemplateCell& c : cells) {
     std::array<int16_t, 8> child{};
     for (int v = 0; v < 8; ++v) {
       const auto [it, inserted] = index.emplace(c.key[v], static_cast<int16_t>(t->nodes.size()));
-      if (inserted) t->nodes.push_back({c.ref[v]});
+      if (inserted) {
+        TemplateNode n{c.ref[v]};
+        n.shared = refiner.is_alias_target(c.key[v]);
+        t->nodes.push_back(n);
+        t->reference.push_back(c.place[v]);
+        moved = moved || c.place[v] != c.ref[v];
+      }
       child[v] = it->second;
     }
     t->children.push_back(child);
   }
+  if (!moved) t->reference.clear();
+  if (configuration_table) template_reference_from_configurations(*t);
   template_compile(*t, 1);
   return t;
 }

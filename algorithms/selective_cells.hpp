@@ -28,6 +28,9 @@ struct TemplateCell {
   std::array<NodeKey, 8> key{};          ///< key of each corner, before aliasing
   /// Reference position of each corner in the hex's cube (exact ones: param / unit).
   std::array<std::array<double, 3>, 8> ref{};
+  /// Reference position of each corner for the reference placement (template_reference.hpp):
+  /// the steps' templates' reference positions composed through the cells' `place` corners.
+  std::array<std::array<double, 3>, 8> place{};
   /// Local axis k of this cell belongs to the sheet of axis axis[k] of the input hex (-1: a sheet
   /// closed inside a template, never refined again).
   std::array<int8_t, 3> axis = {0, 1, 2};
@@ -57,6 +60,9 @@ class CellRefiner {
   /// `key` after aliasing.
   const NodeKey& resolve(const NodeKey& key) const;
 
+  /// Some alias names `key` as its target (an adjustment node that neighbours name too).
+  bool is_alias_target(const NodeKey& key) const { return alias_targets_.count(key) > 0; }
+
   /// Refines `cell` by `tmpl` in orientation `symmetry`, appending the children (their keys,
   /// params and axes filled in); `node_keys`, if given, receives the key of each template node
   /// (before aliasing), indexed like tmpl.nodes. Throws OperationError if the cell cannot be
@@ -71,14 +77,19 @@ class CellRefiner {
   const HexMesh& mesh_;
   const HexTopology& topology_;
   std::unordered_map<NodeKey, NodeKey, NodeKeyHash> aliases_;
+  std::unordered_set<NodeKey, NodeKeyHash> alias_targets_;
   std::unordered_set<NodeKey, NodeKeyHash> used_;
   int64_t off_grid_count_ = 0;
 };
 
 /// The template of one hex made of its cells: nodes at the cells' corner positions (exact ones
 /// on the grid, so the engine keys them and neighbours share them; off-grid ones strictly inside),
-/// children the cells, tag `tag`; compiled for symmetry 0 only.
+/// children the cells, tag `tag`; compiled for symmetry 0 only. Reference positions: the cells'
+/// composed `place` corners, the movable nodes (strictly inside, no alias target of `refiner`,
+/// which are TemplateNode::shared) from the committed table of directional configurations when
+/// it lists this one and `configuration_table` is set (template_reference.hpp).
 std::unique_ptr<HexTemplate> selective_cells_template(const std::vector<TemplateCell>& cells,
-                                                      TemplateTag tag);
+                                                      TemplateTag tag, const CellRefiner& refiner,
+                                                      bool configuration_table = true);
 
 }  // namespace hexrefine

@@ -16,6 +16,7 @@
 #include "algorithms/sheet_rounds.hpp"
 
 #include "algorithms/sheet.hpp"
+#include "algorithms/template_reference.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -148,7 +149,8 @@ const Orientation* sheet_orientation(uint16_t split_mask) {
 }
 
 RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int32_t>& color,
-                        int32_t round, const std::function<std::string(int32_t)>& piece_name) {
+                        int32_t round, const std::function<std::string(int32_t)>& piece_name,
+                        TemplatePositions positions) {
   const int32_t count = mesh.hex_count();
   const HexTopology rt = topology_build(mesh);
   RefinementPlan plan;
@@ -209,7 +211,7 @@ RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int3
     }
   }
 
-  PlanApplyResult applied = plan_apply(mesh, rt, plan);
+  PlanApplyResult applied = plan_apply(mesh, rt, plan, 1, positions);
   RoundCounts counts{applied.hexes_created, applied.hexes_deleted};
 
   // The next state: occurrences inherited through the children's axes, edge nodes marked.
@@ -246,39 +248,53 @@ RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int3
 
 std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
                                                       const std::array<int8_t, 3>& rank,
-                                                      int32_t input_hex) {
-  HexMesh cube;
-  RoundState state;
-  for (int v = 0; v < 8; ++v) {
-    cube.points.emplace_back(hex_corner[v][0], hex_corner[v][1], hex_corner[v][2]);
-    state.node_marked.push_back((marks >> v) & 1);
-  }
-  cube.hexes.push_back({0, 1, 2, 3, 4, 5, 6, 7});
-  state.origin = {input_hex};
-  state.occurrence = {{rank[0], rank[1], rank[2]}};
+                                                      int32_t input_hex, bool configuration_table) {
   const std::vector<int32_t> color = {0, 1, 2};
   const int32_t rounds = 1 + std::max({rank[0], rank[1], rank[2]});
   auto c = std::make_unique<SheetComposite>();
-  for (int32_t round = 0; round < rounds; ++round) {
-    const RoundCounts r = sheet_round(cube, state, color, round, [&](int32_t piece) {
-      std::string axes;
-      for (int k = 0; k < 3; ++k)
-        if (rank[k] == piece) axes += "xyz"[k];
-      return "through local axes " + axes + " of input hex " + std::to_string(input_hex);
-    });
-    c->counts.created += r.created;
-    c->counts.deleted += r.deleted;
-  }
+  // The rounds on the unit cube, at the templates' exact positions and then at their reference
+  // positions: the same nodes in the same order (what is created depends on the marks alone).
+  auto run = [&](TemplatePositions positions, bool count) {
+    HexMesh cube;
+    RoundState state;
+    for (int v = 0; v < 8; ++v) {
+      cube.points.emplace_back(hex_corner[v][0], hex_corner[v][1], hex_corner[v][2]);
+      state.node_marked.push_back((marks >> v) & 1);
+    }
+    cube.hexes.push_back({0, 1, 2, 3, 4, 5, 6, 7});
+    state.origin = {input_hex};
+    state.occurrence = {{rank[0], rank[1], rank[2]}};
+    for (int32_t round = 0; round < rounds; ++round) {
+      const RoundCounts r = sheet_round(
+          cube, state, color, round,
+          [&](int32_t piece) {
+            std::string axes;
+            for (int k = 0; k < 3; ++k)
+              if (rank[k] == piece) axes += "xyz"[k];
+            return "through local axes " + axes + " of input hex " + std::to_string(input_hex);
+          },
+          positions);
+      if (!count) continue;
+      c->counts.created += r.created;
+      c->counts.deleted += r.deleted;
+    }
+    return cube;
+  };
+  const HexMesh cube = run(TemplatePositions::exact, true);
+  const HexMesh placed = run(TemplatePositions::reference, false);
   c->tmpl = std::make_unique<HexTemplate>();
   HexTemplate& t = *c->tmpl;
   t.tag = TemplateTag::sheet;
   for (const Eigen::Vector3d& x : cube.points) t.nodes.push_back({{x[0], x[1], x[2]}});
+  if (placed.points != cube.points)
+    for (const Eigen::Vector3d& x : placed.points) t.reference.push_back({x[0], x[1], x[2]});
   for (int32_t h = 0; h < cube.hex_count(); ++h) {
     std::array<int16_t, 8> child{};
     for (int k = 0; k < 8; ++k) child[k] = static_cast<int16_t>(cube.hexes[h][k]);
     t.children.push_back(child);
     c->positive = c->positive && hex_corners_positive(hex_points(cube, h));
   }
+  if (configuration_table) template_reference_from_configurations(t);
   template_compile(t, 1);
   composite_face_hashes(t, c->face_hash);
   return c;

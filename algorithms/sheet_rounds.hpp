@@ -49,17 +49,23 @@ struct RoundState {
 /// Round `round` over the whole `mesh`: every hex refines the local axes whose piece has colour
 /// `round` (color[piece]), with the directional template its split edges (node marks) call for;
 /// children inherit the pieces of the parent axes their edges run along, new nodes inside split
-/// edges are marked. `piece_name` describes a piece for messages. Throws OperationError where a
-/// hex has no directional template or two hexes around a split edge would not split it in the
-/// same round.
+/// edges are marked. `piece_name` describes a piece for messages. New nodes go to their parent's
+/// trilinear map of the templates' `positions` (what is created does not depend on it). Throws
+/// OperationError where a hex has no directional template or two hexes around a split edge would
+/// not split it in the same round.
 RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int32_t>& color,
-                        int32_t round, const std::function<std::string(int32_t)>& piece_name);
+                        int32_t round, const std::function<std::string(int32_t)>& piece_name,
+                        TemplatePositions positions = TemplatePositions::exact);
 
 /// What the rounds do to one hex with corner marks `marks` (bit v: vertex v marked) whose local
 /// axis k is refined in round rank[k] (-1: never), as one template (TemplateTag::sheet, on the
-/// exact grid, compiled for symmetry 0), with the hashes of its six face subdivisions per face
-/// frame (face_hash[lf][2 * i0 + (step == 1 ? 0 : 1)]: origin at position i0 of hex_faces[lf],
-/// u towards i0 + step) so neighbours can be compared before anything is applied.
+/// exact grid, compiled for symmetry 0; its reference positions the rounds run again with the
+/// directional templates' reference positions, so the face rules of template_reference.hpp
+/// compose as in the Selective Approach's directional hexes; its movable nodes from the table
+/// of configurations when `configuration_table` is set and the table lists it), with the hashes of
+/// its six face subdivisions per face frame (face_hash[lf][2 * i0 + (step == 1 ? 0 : 1)]: origin at
+/// position i0 of hex_faces[lf], u towards i0 + step) so neighbours can be compared before anything
+/// is applied.
 struct SheetComposite {
   std::unique_ptr<HexTemplate> tmpl;
   RoundCounts counts;
@@ -68,7 +74,8 @@ struct SheetComposite {
 };
 std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
                                                       const std::array<int8_t, 3>& rank,
-                                                      int32_t input_hex);
+                                                      int32_t input_hex,
+                                                      bool configuration_table = true);
 
 /// Hash of an unrefined face (any frame).
 uint64_t sheet_whole_face_hash();

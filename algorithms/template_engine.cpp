@@ -107,9 +107,11 @@ NodeKey node_key_at(const HexMesh& mesh, const HexTopology& topology, HexId hex_
   return NodeKey::interior(hex_id, p);
 }
 
-TemplateEngine::TemplateEngine(const HexMesh& mesh, const HexTopology& topology)
+TemplateEngine::TemplateEngine(const HexMesh& mesh, const HexTopology& topology,
+                               TemplatePositions positions)
     : mesh_(mesh),
       topology_(topology),
+      positions_(positions),
       points_(mesh.points),
       edge_slot_(3 * static_cast<size_t>(topology.edge_count()), -1),
       face_base_(topology.face_count(), -1) {
@@ -158,6 +160,10 @@ int32_t TemplateEngine::create_node(const Eigen::Vector3d& x) {
 }
 
 Eigen::Vector3d TemplateEngine::interior_position(const NodeKey& key) const {
+  if (!interior_reference_.empty()) {
+    const auto it = interior_reference_.find(key);
+    if (it != interior_reference_.end()) return it->second;
+  }
   return weighted(param_weights(key.interior_param()), hex_points(mesh_, key.id()));
 }
 
@@ -232,7 +238,7 @@ void TemplateEngine::apply(HexId hex, const HexTemplate& t, int symmetry, bool i
   placed_.resize(plan.nodes.size());
   for (size_t i = 0; i < plan.nodes.size(); ++i) {
     const TemplatePlanNode& n = plan.nodes[i];
-    auto position = [&] { return weighted(n.weight, x); };
+    auto position = [&] { return weighted(weights(n), x); };
     int32_t id = -1;
     switch (n.entity) {
       case CubeEntity::corner:
@@ -340,7 +346,7 @@ void TemplateEngine::apply_batch(std::span<const TemplateUse> uses,
           ++own;
         }
         ids[j] = id;
-        points_[id] = weighted(n.weight, x);
+        points_[id] = weighted(weights(n), x);
       }
       HexCell* out = children.data() + child_offset[i];
       for (const auto& c : plan.children) {
@@ -368,7 +374,7 @@ void TemplateEngine::apply_batch(std::span<const TemplateUse> uses,
 }
 
 PlanApplyResult plan_apply(const HexMesh& mesh, const HexTopology& topology,
-                           const RefinementPlan& plan, int threads) {
+                           const RefinementPlan& plan, int threads, TemplatePositions positions) {
   const int32_t nh = mesh.hex_count();
   std::vector<int32_t> use_of(nh, -1);
   int32_t previous = -1;
@@ -380,7 +386,7 @@ PlanApplyResult plan_apply(const HexMesh& mesh, const HexTopology& topology,
     previous = h;
     use_of[h] = static_cast<int32_t>(i);
   }
-  TemplateEngine engine(mesh, topology);
+  TemplateEngine engine(mesh, topology, positions);
   // Hexes whose interior nodes someone else names (alias sources or targets) key them.
   std::vector<uint8_t> interior_keyed;
   for (const NodeAlias& al : plan.aliases) {
@@ -390,6 +396,19 @@ PlanApplyResult plan_apply(const HexMesh& mesh, const HexTopology& topology,
         if (interior_keyed.empty()) interior_keyed.assign(nh, 0);
         interior_keyed[k->id()] = 1;
       }
+  }
+  if (positions == TemplatePositions::reference && !interior_keyed.empty()) {
+    // An alias target is placed by its own hex's template, whoever names it first: its
+    // reference position may differ from its exact one.
+    for (const TemplateUse& u : plan.uses) {
+      const int32_t h = index_of(u.hex);
+      if (!interior_keyed[h]) continue;
+      const std::array<Eigen::Vector3d, 8> x = hex_points(mesh, h);
+      for (const TemplatePlanNode& n : u.tmpl->plans.at(u.symmetry).nodes)
+        if (n.entity == CubeEntity::interior && !n.off_grid)
+          engine.set_interior_position(NodeKey::interior(u.hex, n.param),
+                                       weighted(n.reference_weight, x));
+    }
   }
 
   PlanApplyResult out;

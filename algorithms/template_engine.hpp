@@ -15,8 +15,10 @@
 /// Because both hexes of an edge or face derive the same key for the same position, neighbours
 /// share nodes and conformity holds by construction. A node is placed where the first hex that
 /// creates it maps its position trilinearly (on a shared face both hexes' maps agree: the bilinear
-/// face map). Where a node finally goes is decided later (node_placement.hpp): it never decides
-/// which nodes exist.
+/// face map): its exact position (the thesis' placement) or its reference position
+/// (template_reference.hpp, whose rule for edge and face nodes depends only on the edge's or
+/// face's subdivision, so that there too it does not matter which hex comes first). Where a node
+/// finally goes is decided later (node_placement.hpp): it never decides which nodes exist.
 /// Lookup goes through flat slot arrays wherever a key lies on the thirds-and-halves grid of its
 /// entity (three slots per input edge, nine per used input face); keys off that grid (sub-cells
 /// nested deeper, keys named by aliases) go to a hash table.
@@ -127,14 +129,17 @@ struct PlanApplyResult {
   int64_t hexes_created = 0, hexes_deleted = 0;
 };
 
-/// Applies `plan` to `mesh`. `threads` > 1 writes the positions and children of whole-hex
-/// applications in parallel after the node ids have been claimed in hex order (the output does
-/// not depend on it; serial when the plan has aliases or a template off the slot grid).
+/// Applies `plan` to `mesh`, every new node at its parent's trilinear map of its template's
+/// `positions` (exact: the thesis'; reference: HexTemplate::reference). `threads` > 1 writes the
+/// positions and children of whole-hex applications in parallel after the node ids have been
+/// claimed in hex order (the output does not depend on it; serial when the plan has aliases or a
+/// template off the slot grid). The nodes and hexes do not depend on `positions`.
 /// Preconditions: `topology` built from `mesh` (TopologyParts::all); uses as documented.
 /// Throws OperationError naming the hex if an application would give a hex with a repeated node
 /// (an alias collapsing two corners of one child).
 PlanApplyResult plan_apply(const HexMesh& mesh, const HexTopology& topology,
-                           const RefinementPlan& plan, int threads = 1);
+                           const RefinementPlan& plan, int threads = 1,
+                           TemplatePositions positions = TemplatePositions::exact);
 
 /// Attributes of a refined mesh from its parents: every attribute of `input` inherited by its
 /// children; "template_tag" = tag_of[parent] where that is >= 0 (a refined parent; untouched
@@ -148,7 +153,16 @@ void mesh_attributes_from_parents(const HexMesh& input, std::span<const int32_t>
 class TemplateEngine {
  public:
   /// `mesh` and `topology` must outlive the engine; output points start as a copy of the input's.
-  TemplateEngine(const HexMesh& mesh, const HexTopology& topology);
+  /// New nodes go to the parent's trilinear map of their template's `positions`.
+  TemplateEngine(const HexMesh& mesh, const HexTopology& topology,
+                 TemplatePositions positions = TemplatePositions::exact);
+
+  /// With reference positions: the position of the alias target `key` (an interior key of the
+  /// adjusting hex), which another hex may name first; by default its hex's trilinear map of
+  /// the key's exact position.
+  void set_interior_position(const NodeKey& key, const Eigen::Vector3d& x) {
+    interior_reference_[key] = x;
+  }
 
   /// Nodes named `from` are the node named `to` from now on. Precondition: no node created yet.
   void alias(const NodeKey& from, const NodeKey& to);
@@ -192,8 +206,15 @@ class TemplateEngine {
   NodeKey plan_node_key(int32_t hex, const TemplatePlanNode& n,
                         std::array<std::array<int8_t, 3>, 6>& frame) const;
 
+  /// The weights a compiled node is placed by (positions_).
+  const std::array<double, 8>& weights(const TemplatePlanNode& n) const {
+    return positions_ == TemplatePositions::reference ? n.reference_weight : n.weight;
+  }
+
   const HexMesh& mesh_;
   const HexTopology& topology_;
+  TemplatePositions positions_;
+  std::unordered_map<NodeKey, Eigen::Vector3d, NodeKeyHash> interior_reference_;
   std::vector<Eigen::Vector3d> points_;
   std::vector<int32_t> edge_slot_;  ///< 3 per input edge: sixths 2, 3, 4 in the edge's direction
   std::vector<int32_t> face_base_;  ///< per input face: offset into face_slot_, or -1

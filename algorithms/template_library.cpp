@@ -11,6 +11,7 @@
 #include <span>
 #include <string>
 
+#include "algorithms/template_reference.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
 #include "mesh/quality.hpp"
@@ -243,6 +244,7 @@ HexTemplate template_from_table(TemplateTag tag, std::span<const NodeRow> nodes,
     t.nodes.push_back({{n.x / 6.0, n.y / 6.0, n.z / 6.0}, n.adjustment_edge, n.adjustment_index});
   t.children.assign(children.begin(), children.end());
   template_compute_child_axes(t);
+  template_reference_from_table(t);
   template_compile(t);
   return t;
 }
@@ -305,25 +307,23 @@ std::array<double, 8> hex_trilinear_weights(const std::array<double, 3>& p) {
 }
 
 const HexTemplate& template_1_27() {
-  static const HexTemplate t =
+  static HexTemplate t =
       template_from_table(TemplateTag::t1_27, grid_1_27.nodes, grid_1_27.children);
   return t;
 }
 
 const HexTemplate& template_1_9() {
-  static const HexTemplate t =
-      template_from_table(TemplateTag::t1_9, grid_1_9.nodes, grid_1_9.children);
+  static HexTemplate t = template_from_table(TemplateTag::t1_9, grid_1_9.nodes, grid_1_9.children);
   return t;
 }
 
 const HexTemplate& template_1_3() {
-  static const HexTemplate t =
-      template_from_table(TemplateTag::t1_3, grid_1_3.nodes, grid_1_3.children);
+  static HexTemplate t = template_from_table(TemplateTag::t1_3, grid_1_3.nodes, grid_1_3.children);
   return t;
 }
 
 const HexTemplate& template_1_13() {
-  static const HexTemplate t = template_from_table(TemplateTag::t1_13, nodes_1_13, children_1_13);
+  static HexTemplate t = template_from_table(TemplateTag::t1_13, nodes_1_13, children_1_13);
   return t;
 }
 
@@ -339,25 +339,41 @@ HexTemplate template_1_13_build(double interior_height) {
 }
 
 const HexTemplate& template_1_5() {
-  static const HexTemplate t = template_from_table(TemplateTag::t1_5, nodes_1_5, children_1_5);
+  static HexTemplate t = template_from_table(TemplateTag::t1_5, nodes_1_5, children_1_5);
   return t;
 }
 
 const HexTemplate& template_1_4() {
-  static const HexTemplate t = template_from_table(TemplateTag::t1_4, nodes_1_4, children_1_4);
+  static HexTemplate t = template_from_table(TemplateTag::t1_4, nodes_1_4, children_1_4);
   return t;
 }
 
 const HexTemplate& template_1_3_adjust1() {
-  static const HexTemplate t =
+  static HexTemplate t =
       template_from_table(TemplateTag::t1_3_adjust1, nodes_1_3_adjust1, children_adjusted);
   return t;
 }
 
 const HexTemplate& template_1_3_adjust2() {
-  static const HexTemplate t =
+  static HexTemplate t =
       template_from_table(TemplateTag::t1_3_adjust2, nodes_1_3_adjust2, children_adjusted);
   return t;
+}
+
+void template_set_reference(TemplateTag tag, std::vector<std::array<double, 3>> reference) {
+  const HexTemplate* found = nullptr;
+  for (const HexTemplate* t :
+       {&template_1_27(), &template_1_13(), &template_1_5(), &template_1_4(), &template_1_3(),
+        &template_1_3_adjust1(), &template_1_3_adjust2(), &template_1_9()})
+    if (t->tag == tag) found = t;
+  if (!found)
+    throw OperationError(std::string("template_set_reference: no standard template ") +
+                         template_tag_name(tag));
+  // The standard templates are function-local statics that are not const: this is their one
+  // writer.
+  HexTemplate& t = const_cast<HexTemplate&>(*found);
+  t.reference = std::move(reference);
+  template_compile(t);
 }
 
 bool template_is_adjusted(const HexTemplate& tmpl) {
@@ -463,13 +479,32 @@ void template_compute_child_axes(HexTemplate& t) {
 
 void template_compile(HexTemplate& t, int symmetry_count) {
   constexpr int64_t unit = template_param_unit, sixth = unit / 6;
+  if (!t.reference.empty() && t.reference.size() != t.nodes.size())
+    throw OperationError(std::string("template ") + template_tag_name(t.tag) + ": " +
+                         std::to_string(t.reference.size()) + " reference positions for " +
+                         std::to_string(t.nodes.size()) + " nodes");
+  t.child_reference_quality.clear();
+  t.reference_edge_ratio = 1;
+  for (const auto& child : t.children) {
+    HexCorners x;
+    for (int k = 0; k < 8; ++k) {
+      const auto& r = template_node_reference(t, static_cast<size_t>(child[k]));
+      x[k] = Eigen::Vector3d(r[0], r[1], r[2]);
+    }
+    t.child_reference_quality.push_back(hex_scaled_jacobian(x));
+    t.reference_edge_ratio = std::max(t.reference_edge_ratio, hex_edge_ratio(x));
+  }
   t.plans.assign(static_cast<size_t>(symmetry_count), {});
   for (int sym = 0; sym < symmetry_count; ++sym) {
     const CubeSymmetry& s = cube_symmetries()[sym];
     TemplatePlan& plan = t.plans[sym];
-    for (const TemplateNode& tn : t.nodes) {
+    for (size_t i = 0; i < t.nodes.size(); ++i) {
+      const TemplateNode& tn = t.nodes[i];
       TemplatePlanNode n;
       const std::array<double, 3> p = cube_symmetry_apply(s, tn.ref);
+      const bool moved = !t.reference.empty() && t.reference[i] != tn.ref;
+      const std::array<double, 3> reference_point =
+          moved ? cube_symmetry_apply(s, t.reference[i]) : p;
       // Exact positions: multiples of 1 / template_param_unit (thirds and sixths of the standard
       // templates, and the finer positions of templates made of sub-cells).
       bool on_grid = true, inside = true;
@@ -496,12 +531,14 @@ void template_compile(HexTemplate& t, int symmetry_count) {
         n.param = {};
         n.p6 = {-1, -1, -1};
         n.weight = hex_trilinear_weights(p);
+        n.reference_weight = moved ? hex_trilinear_weights(reference_point) : n.weight;
         plan.nodes.push_back(n);
         continue;
       }
       // The weights of the exact position (the same expression wherever a key is placed).
       n.weight = hex_trilinear_weights(
           {double(n.param[0]) / unit, double(n.param[1]) / unit, double(n.param[2]) / unit});
+      n.reference_weight = moved ? hex_trilinear_weights(reference_point) : n.weight;
       // Slot grid: sixths 2, 3 and 4 in every free coordinate.
       bool slot_grid = true;
       for (int k = 0; k < 3; ++k) {
@@ -538,7 +575,7 @@ void template_compile(HexTemplate& t, int symmetry_count) {
   }
 }
 
-double template_validate(const HexTemplate& tmpl) {
+double template_validate(const HexTemplate& tmpl, TemplatePositions positions) {
   auto fail = [&](const std::string& why) {
     throw OperationError(std::string("template ") + template_tag_name(tmpl.tag) + ": " + why);
   };
@@ -547,7 +584,9 @@ double template_validate(const HexTemplate& tmpl) {
   for (size_t c = 0; c < tmpl.children.size(); ++c) {
     HexCorners x;
     for (int k = 0; k < 8; ++k) {
-      const auto& r = tmpl.nodes.at(tmpl.children[c][k]).ref;
+      const size_t i = static_cast<size_t>(tmpl.children[c][k]);
+      const auto& r = positions == TemplatePositions::reference ? template_node_reference(tmpl, i)
+                                                                : tmpl.nodes.at(i).ref;
       x[k] = Eigen::Vector3d(r[0], r[1], r[2]);
     }
     const double sj = hex_scaled_jacobian(x);
@@ -569,7 +608,10 @@ double template_validate(const HexTemplate& tmpl) {
   for (const TemplateNode& n : tmpl.nodes) adjusted |= n.adjustment_edge >= 0;
   if (!adjusted && std::abs(volume - 1.0) > 1e-9)
     fail("children fill volume " + std::to_string(volume) + ", not the unit cube");
-  if (adjusted && (volume >= 1.0 - 1e-9 || volume <= 0.5))
+  // The exact adjustment nodes (depth 5/6) leave a wedge of 1/6 x 1/6 / 2 of the section, more
+  // than half the cube always; reference positions may sit deeper.
+  const double least = positions == TemplatePositions::exact ? 0.5 : 0.0;
+  if (adjusted && (volume >= 1.0 - 1e-9 || volume <= least))
     fail("adjusted children fill volume " + std::to_string(volume));
   return min_sj;
 }

@@ -8,14 +8,21 @@
 /// 1/6 and 5/6 for the 1-13 interior and the adjustment nodes); nothing here applies them (that
 /// is template_engine.hpp) or turns them (cube_symmetry.hpp).
 ///
+/// Every template has two positions per node: the exact one (the thesis' positions: what the node
+/// is keyed by, so which nodes exist never depends on where they go) and a reference position
+/// (template_reference.hpp: the positions that maximise the minimum scaled Jacobian of the
+/// children on the unit cube, computed offline and read from a committed table), where the
+/// reference placement puts the node through its parent's trilinear map.
+///
 /// Also here, because they are data derived from the tables once:
 ///  - the mask table: which template and symmetry a split-edge pattern calls for, for both
 ///    refiners (TemplateSet);
 ///  - per template and symmetry, the compiled plan: each node classified by the entity of a hex
-///    it lies on (corner, edge, face, inside), its exact position and trilinear weights, children
-///    re-oriented for the symmetry.
+///    it lies on (corner, edge, face, inside), its exact position and the trilinear weights of
+///    its exact and of its reference position, children re-oriented for the symmetry.
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -55,6 +62,9 @@ struct TemplateNode {
   std::array<double, 3> ref;
   int8_t adjustment_edge = -1;  ///< >= 0: an adjustment node of this canonical local edge
   int8_t adjustment_index = 0;
+  /// Named by another hex too (a directional configuration's adjustment node, which the
+  /// neighbours' aliases name): its reference position is not the template's to choose.
+  bool shared = false;
 };
 
 /// What part of a hex a reference position lies on.
@@ -70,6 +80,9 @@ struct TemplatePlanNode {
   TemplateParam param{};           ///< exact position in the hex's cube (when on the grid)
   std::array<int8_t, 3> p6{};      ///< the same in sixths where it is a multiple of 1/6, else -1
   std::array<double, 8> weight{};  ///< trilinear weights of the hex corners at that position
+  /// Trilinear weights at the node's reference position (HexTemplate::reference) in this
+  /// symmetry; equal to `weight` where the reference position is the exact one.
+  std::array<double, 8> reference_weight{};
 };
 
 /// A template compiled for one cube symmetry: children re-oriented for it (positive in the
@@ -94,17 +107,37 @@ struct HexTemplate {
   /// geometric: in 1-4 the top child's "y" edges lie on the sheet that turns round from the
   /// split x-edge, so that direction belongs to x. Filled by template_compute_child_axes.
   std::vector<std::array<int8_t, 3>> child_axis;
+  /// Reference position of each node in the canonical cube (empty: every node at its exact
+  /// position `ref`). Corners and adjustment nodes stay where `ref` puts them; a node on an edge
+  /// or face of the cube is where template_reference.hpp's rule for that edge's or face's
+  /// subdivision puts it (so two hexes sharing it agree); a node inside the cube is free.
+  std::vector<std::array<double, 3>> reference;
+  /// Per child: its scaled Jacobian on the unit cube with every node at its reference position
+  /// (template_compile): what the child is on an undistorted parent (node_placement.cpp's
+  /// yardstick in a later pass, whose parents are the earlier passes' children).
+  std::vector<double> child_reference_quality;
+  /// The largest edge ratio of a child on the unit cube at the reference positions
+  /// (template_compile).
+  double reference_edge_ratio = 1;
   /// Per cube symmetry: the compiled template (template_compile); the standard templates have
   /// all 48, a template made for one hex (plan-owned) only symmetry 0.
   std::vector<TemplatePlan> plans;
 };
 
+/// Reference position of node i of `tmpl` (its exact position `ref` when tmpl.reference is
+/// empty).
+inline const std::array<double, 3>& template_node_reference(const HexTemplate& tmpl,
+                                                            std::size_t i) {
+  return tmpl.reference.empty() ? tmpl.nodes[i].ref : tmpl.reference[i];
+}
+
 /// Fills tmpl.child_axis.
 void template_compute_child_axes(HexTemplate& tmpl);
 
-/// Fills tmpl.plans for symmetries 0 .. symmetry_count - 1 (48: all). Throws OperationError if a
+/// Fills tmpl.plans for symmetries 0 .. symmetry_count - 1 (48: all) and
+/// tmpl.child_reference_quality. Throws OperationError if a
 /// node off the exact grid is not strictly inside the cube (it could not be shared with a
-/// neighbour).
+/// neighbour), or if tmpl.reference is neither empty nor one position per node.
 void template_compile(HexTemplate& tmpl, int symmetry_count = 48);
 
 /// The standard templates in canonical orientation, compiled for all 48 symmetries.
@@ -126,7 +159,14 @@ const HexTemplate& template_1_3_adjust2();
 /// template): where a dual sheet crosses itself in a fully refined hex (sheet refinement).
 const HexTemplate& template_1_9();
 
-/// 1-13 with its four interior nodes at height `interior_height` in (0, 1) (for quality scans).
+/// Replaces the reference positions of the standard template tagged `tag` (empty: the exact
+/// ones) and compiles it again. For the offline optimisation (template_reference_install) only:
+/// not thread-safe, and no refinement may run meanwhile. Throws OperationError for a tag with no
+/// standard template or a wrong count.
+void template_set_reference(TemplateTag tag, std::vector<std::array<double, 3>> reference);
+
+/// 1-13 with its four interior nodes at height `interior_height` in (0, 1) (for quality scans;
+/// reference positions the exact ones).
 HexTemplate template_1_13_build(double interior_height);
 /// Height of the four interior nodes of 1-13. The minimum scaled Jacobian is 4/13 = 0.3077 (the
 /// thesis' L-shaped value) for every height in (0, 0.27], fixed by the corner children; above
@@ -161,11 +201,17 @@ TemplateChoice template_for_mask(uint16_t mask, TemplateSet set = TemplateSet::e
 /// True for the two adjusted 1-3 templates (their adjustment nodes merge neighbours' faces).
 bool template_is_adjusted(const HexTemplate& tmpl);
 
-/// Checks a template on the unit cube: every child has positive scaled Jacobian, children fill the
-/// cube (volumes sum to 1; an adjusted template leaves a wedge at its unsplit edge to the
-/// neighbours), and no face is shared by more than two children. Returns the minimum scaled
-/// Jacobian of the children; throws OperationError describing the first defect.
-double template_validate(const HexTemplate& tmpl);
+/// Which position of each template node: the exact one (TemplateNode::ref, the thesis') or the
+/// reference one (HexTemplate::reference).
+enum class TemplatePositions : uint8_t { exact, reference };
+
+/// Checks a template on the unit cube with its nodes at `positions`: every child has positive
+/// scaled Jacobian, children fill the cube (volumes sum to 1; an adjusted template leaves a
+/// wedge at its unsplit edge to the neighbours), and no face is shared by more than two
+/// children. Returns the minimum scaled Jacobian of the children; throws OperationError
+/// describing the first defect.
+double template_validate(const HexTemplate& tmpl,
+                         TemplatePositions positions = TemplatePositions::exact);
 
 /// Split-edge bit mask of a canonical template: local edges that carry edge nodes.
 uint16_t template_split_edges(const HexTemplate& tmpl);

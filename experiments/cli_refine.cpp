@@ -74,10 +74,13 @@ int refine_run(const CliArgs& a) {
       o.refine.placement.method = PlacementMethod::optimized;
     else if (*p == "untangle")
       o.refine.placement.method = PlacementMethod::untangle;
+    else if (*p == "reference")
+      o.refine.placement.method = PlacementMethod::reference;
     else
       throw InputError(
-          "hexrefine refine: --placement must be trilinear, optimized or untangle, got '" + *p +
-          "'");
+          "hexrefine refine: --placement must be trilinear, reference, optimized or untangle, "
+          "got '" +
+          *p + "'");
   }
   o.smooth = a.flag("--smooth");
   if (!a.value("--placement")) o.refine.placement.method = pipeline_default_placement(o.smooth);
@@ -151,9 +154,11 @@ const CliCommand cli_refine_command = {
          "H-2), transitions (every transition's children, cumulative) or none"},
         {"--no-buffer", "", "ablation: the same as --buffer none"},
         {"--placement", "P",
-         "new nodes: trilinear (the thesis' positions), optimized (the default without --smooth: "
-         "raise the worst scaled Jacobian, untangle) or untangle (trilinear, inverted children "
-         "untangled: the default with --smooth, the better start for it)"},
+         "new nodes: trilinear (the thesis' positions), reference (the templates' reference "
+         "positions, best on the unit cube, at trilinear's cost), optimized (the default without "
+         "--smooth: reference, then raise the worst scaled Jacobian where a child is still poor, "
+         "untangle) or untangle (trilinear, inverted children untangled: the default with "
+         "--smooth, the better start for it)"},
         {"--smooth", "",
          "smooth the refined region afterwards (checked again; starts from --placement untangle "
          "unless a placement is given; a smoothing the checker rejects is undone, with a warning "

@@ -181,8 +181,11 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
         c.options.placement.method = PlacementMethod::optimized;
       else if (placement == "untangle")
         c.options.placement.method = PlacementMethod::untangle;
+      else if (placement == "reference")
+        c.options.placement.method = PlacementMethod::reference;
       else
-        op.at("placement").fail("expected \"trilinear\", \"optimized\" or \"untangle\"");
+        op.at("placement")
+            .fail("expected \"trilinear\", \"reference\", \"optimized\" or \"untangle\"");
     }
   }
   if (!j.contains("options") || !j["options"].contains("placement"))

@@ -286,9 +286,12 @@ PYBIND11_MODULE(_hexrefine, m) {
           o.refine.placement.method = PlacementMethod::trilinear;
         else if (placement == "untangle")
           o.refine.placement.method = PlacementMethod::untangle;
+        else if (placement == "reference")
+          o.refine.placement.method = PlacementMethod::reference;
         else if (placement != "optimized")
-          throw InputError("placement must be 'trilinear', 'optimized' or 'untangle', got '" +
-                           placement + "'");
+          throw InputError(
+              "placement must be 'trilinear', 'reference', 'optimized' or 'untangle', got '" +
+              placement + "'");
         o.smooth = smooth;
         if (!(max_edge_ratio == 0 || (max_edge_ratio >= 1 && max_edge_ratio <= 1e6)))
           throw InputError("max_edge_ratio must be 0 or in 1..1e6, got " +
@@ -308,9 +311,10 @@ PYBIND11_MODULE(_hexrefine, m) {
       "propagation"_a = true, "ebe_only"_a = false, "placement"_a = "", "threads"_a = 1,
       "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647}, "max_edge_ratio"_a = 20.0,
       "Refines `targets` (hex ids, or selection specs) by `method` through the pipeline: plan, "
-      "apply, place the new nodes (placement 'optimized', the thesis' 'trilinear', or 'untangle': "
-      "trilinear with inverted children untangled, the better start for smooth=True; none given: "
-      "'untangle' with smooth=True, else 'optimized'), check "
+      "apply, place the new nodes (placement 'optimized', the thesis' 'trilinear', 'reference': "
+      "the templates' reference positions, or 'untangle': trilinear with inverted children "
+      "untangled, the better start for smooth=True; none given: 'untangle' with smooth=True, else "
+      "'optimized'), check "
       "against the input, optionally smooth and check again. Returns (mesh, report): the mesh "
       "with template_tag, refinement_level and parent_hex attributes, the report a dict with the "
       "keys of `hexrefine refine --report`. `buffer` (passes > 1): 'layer' (the thesis' rule), "

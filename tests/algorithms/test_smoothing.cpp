@@ -436,7 +436,7 @@ TEST(Smoothing, RefinedRockerarmSlidesTheInputsBoundaryNodesOnItsSurface) {
     const PipelineResult r = pipeline_run(m, o);  // throws if the smoothed mesh is invalid
     ASSERT_TRUE(r.smoothed_check) << method;
     EXPECT_TRUE(r.smoothed_check->valid()) << method;
-    EXPECT_LT(r.check.min_scaled_jacobian, 0.09) << method;
+    EXPECT_LT(r.check.min_scaled_jacobian, 0.12) << method;
     EXPECT_GT(r.smoothed_check->min_scaled_jacobian, 0.35) << method;
     // Input boundary nodes moved, each still on the input's boundary surface (brute force over
     // the patches near it).

@@ -199,7 +199,7 @@ TEST(SelectiveCells, AWholeCellRefinedIsTheLibraryTemplate) {
       std::vector<TemplateCell> children;
       cells.refine(cells.cell_whole(13), *tmpl, sym, children);
       RefinementPlan own;
-      own.owned.push_back(selective_cells_template(children, TemplateTag::directional));
+      own.owned.push_back(selective_cells_template(children, TemplateTag::directional, cells));
       own.uses.push_back({HexId{13}, own.owned.back().get(), 0});
       const PlanApplyResult a = plan_apply(m, t, own);
       const PlanApplyResult b = plan_apply(m, t, plan_of({{HexId{13}, tmpl, int8_t(sym)}}));

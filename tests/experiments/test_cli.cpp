@@ -88,20 +88,29 @@ TEST(Cli, EveryCommandExplainsItselfAndTheUsageListsEveryOption) {
   EXPECT_NE(unknown.output.find("did you mean refine?"), std::string::npos) << unknown.output;
 }
 
-TEST(CliTemplates, ListsTheLibraryWithItsQualityAlone) {
+TEST(CliTemplates, ListsTheLibraryWithItsQualityAloneAtTheThesisAndTheReferencePositions) {
   const auto dir = test_temp_dir("cli_templates");
   const std::string report = (dir / "t.json").string();
   const CliRun r = cli_run("templates --report " + report);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("1-13"), std::string::npos);
-  const nlohmann::json j = nlohmann::json::parse(test_file_text(report));
+  EXPECT_NE(r.output.find("face rule"), std::string::npos);
+  const nlohmann::json all = nlohmann::json::parse(test_file_text(report));
+  const nlohmann::json& j = all["templates"];
   ASSERT_EQ(j.size(), 8u);
   EXPECT_EQ(j[1]["template"], "1-13");
   EXPECT_NEAR(j[1]["min_scaled_jacobian_alone"].get<double>(), 4.0 / 13.0, 1e-12);
+  EXPECT_NEAR(j[1]["min_scaled_jacobian_reference"].get<double>(), 0.5, 1e-4);
+  EXPECT_GE(j[1]["min_scaled_jacobian_own_rule"].get<double>(),
+            j[1]["min_scaled_jacobian_reference"].get<double>());
   EXPECT_EQ(j[1]["children"], 13);
   EXPECT_EQ(j[7]["template"], "1-9");
   EXPECT_EQ(j[7]["sets"], nlohmann::json({"sheet_directional"}));
   EXPECT_EQ(j[0]["sets"], nlohmann::json({"element_by_element", "sheet_directional"}));
+  for (const auto& t : j) EXPECT_GE(t["min_scaled_jacobian_reference"].get<double>(), 0.4);
+  EXPECT_GT(all["directional_configurations"]["count"].get<int64_t>(), 0);
+  // --optimize checks its output path before computing anything.
+  EXPECT_EQ(cli_run("templates --optimize " + (dir / "no" / "t.inc").string()).exit_code, 2);
 }
 
 }  // namespace

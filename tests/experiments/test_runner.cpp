@@ -157,8 +157,8 @@ TEST(RunPlan, SchemaErrorsNameFileAndJsonPath) {
   c = brick_case("a");
   c["options"] = {{"placement", "smooth"}};
   EXPECT_EQ(error_of(json{{"cases", {c}}}),
-            "cases.json: /cases/0/options/placement: expected \"trilinear\", \"optimized\" or "
-            "\"untangle\"");
+            "cases.json: /cases/0/options/placement: expected \"trilinear\", \"reference\", "
+            "\"optimized\" or \"untangle\"");
   c = brick_case("a");
   c["mesh"]["radius"] = 1.0;
   EXPECT_NE(error_of(json{{"cases", {c}}})

@@ -370,6 +370,13 @@ std::optional<NodeSlide> ReferenceSlides::at_input_node(const Eigen::Vector3d& x
     }
     slide.kind = SlideKind::patches;
   } else if (feature.size() == 2) {
+    // A feature curve that turns at x by more than the feature angle is a corner of the
+    // surface: sliding along one segment would take the corner of the faces that border only
+    // the other across the crease between them (issue 28: ecr_hanger's and ecr_dragon's
+    // smoothings the checker rejected).
+    const Eigen::Vector3d ahead = (feature[0]->other - x).normalized();
+    const Eigen::Vector3d behind = (x - feature[1]->other).normalized();
+    if (ahead.dot(behind) < feature_cos) return std::nullopt;
     for (const Side* s : feature) {
       const Quad& q = reference_.patches[s->patch];
       const auto [it, inserted] = rim_segment_.try_emplace(

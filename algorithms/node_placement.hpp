@@ -148,7 +148,8 @@ class ReferenceSlides {
   /// feature sides when they lie on other than two patches or when the patches' unit normals
   /// (of their diagonals) have a dot product below `feature_cos`. No feature side: the node
   /// slides on the union of its patches (a patches slide); two: along those two sides (a
-  /// segments slide, the feature curve); otherwise, or at a degenerate patch, nullopt (stays).
+  /// segments slide, the feature curve) unless the curve turns at x by more than the feature
+  /// angle (a corner of the surface); otherwise, or at a degenerate patch, nullopt (stays).
   std::optional<NodeSlide> at_input_node(const Eigen::Vector3d& x,
                                          std::span<const int32_t> input_hexes, double feature_cos);
 

@@ -119,6 +119,36 @@ TEST(ReferenceSlides, InputNodeSlidesOnItsPatchesAlongItsFeatureCurveOrStays) {
   EXPECT_EQ(slides.at({1, 0.5, 1}, all, 1 - 1e-9)->kind, SlideKind::segment);
 }
 
+TEST(ReferenceSlides, InputNodeStaysWhereItsFeatureCurveTurns) {
+  // A 2x2x1 brick whose right half is folded by 25 degrees twice: the top bends up along x = 1,
+  // the front wall out. Neither fold is a feature at 30 degrees, but the top-front rim, a
+  // feature curve (top against front), turns by 33.4 degrees at (1, 0, 1): a corner of the
+  // surface, so the node stays (sliding along one rim segment takes the corner of the faces on
+  // the other segment's patches across the turn: issue 28's rejected smoothings). The bottom
+  // rim turns by 25 degrees at (1, 0, 0): the node slides along it.
+  HexMesh m = fixture_brick(2, 2, 1);
+  const double fold = std::tan(25.0 * std::acos(-1.0) / 180.0);
+  for (Eigen::Vector3d& x : m.points)
+    if (x.x() == 2) {
+      if (x.y() == 0) x.y() -= fold;
+      if (x.z() == 1) x.z() += fold;
+    }
+  const BoundaryReference r = boundary_reference_build(m, topology_build(m));
+  SlideGeometry g;
+  ReferenceSlides slides(r, g);
+  const std::vector<int32_t> all = {0, 1, 2, 3};
+  const double feature_cos_30 = std::cos(30.0 * std::acos(-1.0) / 180.0);
+  EXPECT_FALSE(slides.at_input_node({1, 0, 1}, all, feature_cos_30));
+  const std::optional<NodeSlide> bottom = slides.at_input_node({1, 0, 0}, all, feature_cos_30);
+  ASSERT_TRUE(bottom);
+  EXPECT_EQ(bottom->kind, SlideKind::segments);
+  EXPECT_EQ(bottom->count, 2);
+  // The top's fold is no feature: the top centre slides on its four patches.
+  const std::optional<NodeSlide> top = slides.at_input_node({1, 1, 1}, all, feature_cos_30);
+  ASSERT_TRUE(top);
+  EXPECT_EQ(top->kind, SlideKind::patches);
+}
+
 TEST(NodePlacement, ParallelepipedsRefinedByBoxesAreLeftAlone) {
   // Children of a parallelepiped by 1-27 have its scaled Jacobian: nothing to do, nothing
   // evaluated.

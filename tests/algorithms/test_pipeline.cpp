@@ -91,16 +91,29 @@ TEST(Pipeline, FullRefinementChildrenMinimumIsTheMeshMinimum) {
   EXPECT_GT(r.children_min_scaled_jacobian, 0.0);
 }
 
-// Issue 28: smoothing never fails a valid refinement. On ecr_hanger.mesh the smoothing slides
-// the input's boundary nodes across its most warped boundary quads (warp / diagonal 0.05) and
-// the checker rejects a face there; the nodes around it go back to their unsmoothed positions,
-// the mesh is returned valid, never below the unsmoothed minimum, with a warning and a count.
+// Issue 28: smoothing never fails a valid refinement. On ecr_hanger.mesh the smoothing slid
+// input nodes on a feature curve past the point where the curve turns, a face corner crossed
+// the crease and the checker rejected the face. Input nodes now stay where their feature curve
+// turns by more than the feature angle, and that smoothing is valid: 0 nodes undone, 0.1175 ->
+// 0.4046. With a feature angle of 89 degrees the creases no longer count as features, the input
+// nodes slide across them, and the checker rejects faces again: the nodes around them go back
+// to their unsmoothed positions, the mesh is returned valid, never below the unsmoothed
+// minimum, with a warning and a count.
 TEST(Pipeline, SmoothingTheCheckerRejectsIsUndoneNotAnError) {
   const HexMesh input = mesh_read(shared_mesh("ecr_hanger.mesh"));
   PipelineOptions o;
   o.select = {"random:0.02,1"};
   o.smooth = true;
   o.refine.placement.method = pipeline_default_placement(o.smooth);
+  const PipelineResult at_creases = pipeline_run(input, o);
+  ASSERT_TRUE(at_creases.smoothed_check);
+  EXPECT_TRUE(at_creases.smoothed_check->valid());
+  EXPECT_EQ(at_creases.smoothing_nodes_undone, 0);
+  EXPECT_TRUE(at_creases.smoothing_warning.empty()) << at_creases.smoothing_warning;
+  EXPECT_NEAR(at_creases.check.min_scaled_jacobian, 0.1175, 1e-4);
+  EXPECT_NEAR(at_creases.smoothed_check->min_scaled_jacobian, 0.4046, 1e-4);
+
+  o.smoothing.feature_angle_degrees = 89;
   const PipelineResult r = pipeline_run(input, o);
   ASSERT_TRUE(r.smoothed_check);
   EXPECT_TRUE(r.check.valid());

@@ -14,11 +14,11 @@
 /// the input hexes they descend from; nothing is returned or written. With an ablation switch the
 /// result may be non-conformal by design and is returned with the checker's counts.
 /// Smoothing (optional) moves the nodes of the refined region and two layers around it
-/// (algorithms/smoothing.hpp), boundary nodes on the input's boundary surface (the input's own
-/// boundary nodes too, over the input faces around them), and the result is checked against the
-/// input again. Smoothing never turns a valid refinement into an error: where the checker
-/// rejects the smoothed mesh, the smoothed nodes around the defects go back to their unsmoothed
-/// positions (at worst all of them), the report's smoothing.warning says so and
+/// (algorithms/placement/smoothing.hpp), boundary nodes on the input's boundary surface (the
+/// input's own boundary nodes too, over the input faces around them), and the result is checked
+/// against the input again. Smoothing never turns a valid refinement into an error: where the
+/// checker rejects the smoothed mesh, the smoothed nodes around the defects go back to their
+/// unsmoothed positions (at worst all of them), the report's smoothing.warning says so and
 /// smoothing.nodes_undone counts them. An error names the stage that failed: the input only
 /// when the input itself fails the checker.
 
@@ -31,8 +31,8 @@
 #include <string>
 #include <vector>
 
-#include "algorithms/refiner.hpp"
-#include "algorithms/smoothing.hpp"
+#include "algorithms/placement/smoothing.hpp"
+#include "algorithms/refiners/refiner.hpp"
 #include "mesh/conformity.hpp"
 #include "mesh/hex_mesh.hpp"
 #include "mesh/io.hpp"

@@ -1,9 +1,9 @@
 /// \file
 /// `hexrefine smooth IN OUT [--method laplacian|optimize] [--region SPEC ...] [--sweeps N]
 /// [--joint-iterations N]
-/// [--report R.json]`: reads IN, smooths it (algorithms/smoothing.hpp), writes OUT (formats by
-/// extension, mesh/io.hpp) and optionally a JSON report with the minimum and mean scaled Jacobian
-/// before and after, seconds, sweeps and nodes moved.
+/// [--report R.json]`: reads IN, smooths it (algorithms/placement/smoothing.hpp), writes OUT
+/// (formats by extension, mesh/io.hpp) and optionally a JSON report with the minimum and mean
+/// scaled Jacobian before and after, seconds, sweeps and nodes moved.
 ///
 /// --region SPECs (mesh/selection.hpp, united) restrict the moving nodes to those of the selected
 /// hexes; without --region every hex is in the region. A region that selects no hex is not an
@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "algorithms/smoothing.hpp"
+#include "algorithms/placement/smoothing.hpp"
 #include "experiments/cli.hpp"
 #include "experiments/cli_output.hpp"
 #include "mesh/atomic_file.hpp"

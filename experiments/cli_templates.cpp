@@ -1,15 +1,15 @@
 /// \file
 /// `hexrefine templates [--report R.json] [--optimize OUT]`: the template library
-/// (algorithms/template_library.hpp) as a table: every template's split edges, nodes, children,
-/// the minimum scaled Jacobian of its children alone on the unit cube at the exact (thesis')
-/// positions and at the reference positions (algorithms/template_reference.hpp), the bound a
-/// rule of the template's own would reach where the shared face rule stops it, and the sets it
-/// belongs to; the directional configurations of the committed table. The JSON behind
-/// results/templates.md.
+/// (algorithms/templates/template_library.hpp) as a table: every template's split edges, nodes,
+/// children, the minimum scaled Jacobian of its children alone on the unit cube at the exact
+/// (thesis') positions and at the reference positions
+/// (algorithms/templates/template_reference.hpp), the bound a rule of the template's own would
+/// reach where the shared face rule stops it, and the sets it belongs to; the directional
+/// configurations of the committed table. The JSON behind results/templates.md.
 ///
 /// --optimize OUT runs the offline optimisation (template_reference_optimize) and writes the
-/// table's C++ source to OUT (algorithms/template_reference_table.inc is the committed one).
-/// The directional configurations are collected from the plans of a fixed corpus of generated
+/// table's C++ source to OUT (algorithms/templates/template_reference_table.inc is the committed
+/// one). The directional configurations are collected from the plans of a fixed corpus of generated
 /// refinements (selective_plan with the configuration table off: their composed positions),
 /// which are built from the library's compiled-in reference positions: when the optimisation's
 /// rule or templates differ from those, OUT gets the templates alone and the command says to
@@ -24,8 +24,8 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "algorithms/refiner.hpp"
-#include "algorithms/template_reference.hpp"
+#include "algorithms/refiners/refiner.hpp"
+#include "algorithms/templates/template_reference.hpp"
 #include "experiments/cli.hpp"
 #include "experiments/cli_output.hpp"
 #include "mesh/atomic_file.hpp"
@@ -224,13 +224,13 @@ int templates_run(const CliArgs& a) {
     worst_reference = std::min(worst_reference, c.reference_min);
     seen += c.seen;
   }
-  std::cout << "directional configurations in the table: " << used.configurations.size()
-            << " of " << used.corpus_configurations << " in the corpus' " << used.corpus_hexes
+  std::cout << "directional configurations in the table: " << used.configurations.size() << " of "
+            << used.corpus_configurations << " in the corpus' " << used.corpus_hexes
             << " directional hexes (" << seen
             << " of them); worst unit-cube minimum of those composed " << worst_composed
             << ", at the table's positions " << worst_reference
-            << "; of every configuration of the corpus at its positions "
-            << used.corpus_worst_min << "\n";
+            << "; of every configuration of the corpus at its positions " << used.corpus_worst_min
+            << "\n";
   if (report) {
     nlohmann::json out = {
         {"templates", list},
@@ -262,7 +262,7 @@ const CliCommand cli_templates_command = {
     {{"--report", "R.json", "write the table as JSON"},
      {"--optimize", "OUT",
       "compute the reference positions offline and write the table's C++ source to OUT "
-      "(algorithms/template_reference_table.inc is the committed one)"}},
+      "(algorithms/templates/template_reference_table.inc is the committed one)"}},
     "",
     templates_run,
 };

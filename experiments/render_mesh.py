@@ -5,7 +5,7 @@ usage: render_mesh.py MESH OUT.png [--title T] [--field template_tag] [--elev 25
 
 MESH is anything meshio reads with hexahedron cells (e.g. the .vtu files `hexrefine run` writes
 for cases with "save_mesh"). Boundary quads are the hex faces used by exactly one hex; each is
-coloured by the integer cell field (default template_tag, as algorithms/refiner.hpp numbers it)
+coloured by the integer cell field (default template_tag, as algorithms/refiners/refiner.hpp numbers it)
 of its hex and drawn as matplotlib 3D polygons. Without the field every quad is grey.
 """
 
@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-# TemplateTag of algorithms/refiner.hpp.
+# TemplateTag of algorithms/refiners/refiner.hpp.
 TEMPLATE_NAMES = {0: "untouched", 1: "1-27", 2: "1-13", 3: "1-5", 4: "1-4", 5: "1-3",
                   6: "1-3-adj1", 7: "1-3-adj2", 8: "directional", 9: "sheet"}
 TEMPLATE_COLOURS = {0: "#d9d9d9", 1: "#1f77b4", 2: "#ff7f0e", 3: "#2ca02c", 4: "#9467bd",

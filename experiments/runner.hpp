@@ -27,7 +27,7 @@
 #include <string_view>
 #include <vector>
 
-#include "algorithms/refiner.hpp"
+#include "algorithms/refiners/refiner.hpp"
 
 namespace hexrefine {
 

@@ -6,7 +6,7 @@ Why: refining the marked hexes of the current mesh again and again puts transiti
 (1-13, 1-5, 1-4, 1-3) into hexes that are themselves transition children; each time the minimum
 scaled Jacobian falls by about the template's factor (on the L-shape: 1.0, 0.47, 0.13, 0.017,
 0.006 in four steps) until hexrefine refuses the refinement. This is the adaptive loop's form of
-the thesis' pass-buffer rule (algorithms/refiner.hpp, PassBuffer::layer; results/buffer_rules.md),
+the thesis' pass-buffer rule (algorithms/refiners/refiner.hpp, PassBuffer::layer; results/buffer_rules.md),
 with red-green refinement's rule that a marked transition hex refines its regular parent instead.
 
 The state is the initial mesh M_0 and a set of marks: points p with a level d(p) they want. A hex

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "algorithms/selective.hpp"
+#include "algorithms/refiners/selective.hpp"
 #include "experiments/benchmarks/bench_util.hpp"
 #include "experiments/process_huge_pages.hpp"
 #include "mesh/conformity.hpp"

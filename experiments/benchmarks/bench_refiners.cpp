@@ -31,8 +31,8 @@
 #include <memory>
 #include <string>
 
-#include "algorithms/selective.hpp"
-#include "algorithms/sheet.hpp"
+#include "algorithms/refiners/selective.hpp"
+#include "algorithms/refiners/sheet.hpp"
 #include "experiments/benchmarks/bench_util.hpp"
 #include "mesh/generators.hpp"
 #include "mesh/hex_mesh.hpp"

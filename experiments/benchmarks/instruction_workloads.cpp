@@ -55,10 +55,10 @@
 #include <string_view>
 #include <vector>
 
-#include "algorithms/node_placement.hpp"
 #include "algorithms/pipeline.hpp"
-#include "algorithms/refiner.hpp"
-#include "algorithms/smoothing.hpp"
+#include "algorithms/placement/node_placement.hpp"
+#include "algorithms/placement/smoothing.hpp"
+#include "algorithms/refiners/refiner.hpp"
 #include "experiments/benchmarks/bench_util.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/boundary_surface.hpp"

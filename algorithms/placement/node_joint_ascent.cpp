@@ -1,0 +1,484 @@
+/// \file
+/// Joint ascent of the free nodes of a local problem: all of them move at once to raise a smooth
+/// lower bound of the minimum scaled Jacobian.
+///
+/// Sources (formulas and facts only):
+/// - G. Kreisselmeier, R. Steinhauser, "Systematic control design by optimizing a vector
+///   performance index" (1979): KS(s) = m - log(sum_i exp(-beta (s_i - m))) / beta, m = min s_i,
+///   lies in [m - log(n) / beta, m]; its gradient is the softmax-weighted mean of the gradients.
+/// - J. Nocedal, "Updating quasi-Newton matrices with limited storage", Math. Comp. 35 (1980)
+///   773-782: L-BFGS, the two-loop recursion over the last few (step, gradient change) pairs,
+///   and J. Nocedal, S. Wright, "Numerical Optimization" (2006), ch. 3 and 7: backtracking under
+///   the Armijo condition, a pair kept only when its curvature s.y is positive.
+/// - P. Knupp, "Hexahedral and tetrahedral mesh untangling", Eng. Comput. 17 (2001) 261-268, and
+///   the Mesquite toolkit's global solvers: optimizing every free vertex of a mesh at once, which
+///   reaches configurations a vertex-at-a-time sweep cannot when several vertices hold the
+///   worst element together.
+///
+/// Steps:
+///  1. The variables: the problem's free nodes (interior nodes; sliding nodes keep their place,
+///     their slides are the node-by-node optimizer's) of the worst hexes (at most max_seeds of
+///     those within `band` of the worst sample a free node moves) and of `rings` rings of hexes
+///     around them. The objective's hexes: those with a variable corner, with those of their
+///     nine scaled-Jacobian samples (corners, centre: the samples whose minimum is
+///     hex_scaled_jacobian) that a variable moves; a sample no variable moves is a constant.
+///  2. KS of those samples and its analytic gradient (hex by hex, the sample gradients of
+///     hex_scaled_jacobian_gradients weighted and summed, then gathered node by node).
+///  3. L-BFGS iterations maximising KS: the two-loop direction (steepest ascent, scaled to move
+///     the fastest node a fiftieth of the mean edge length, when there is no history or the
+///     direction does not ascend), every step capped at a quarter of the mean edge length,
+///     backtracking until the Armijo condition holds; a step that inverts a hex lowers KS
+///     sharply and is cut back like any other.
+///     They stop after max_iterations, after stall_iterations without the minimum rising, or
+///     when KS stops rising.
+///     An iterate that stretches a hex past its edge-ratio cap (hex_edge_ratio_cap) is
+///     infeasible: its KS is -inf, and the line search cuts the step back as for an inversion.
+///  4. The iterate with the highest true minimum is kept; the start if none beats it (checked
+///     with hex_scaled_jacobian itself).
+/// Threads evaluate chunks of hexes and gather chunks of nodes; every sum is taken in a fixed
+/// order, so the result is the same for any thread count.
+
+#include "algorithms/placement/node_joint_ascent.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include "mesh/hex_convention.hpp"
+#include "mesh/parallel.hpp"
+#include "mesh/quality.hpp"
+
+namespace hexrefine {
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Corners = std::array<Vec3, 8>;
+
+/// The scaled-Jacobian sample of the columns `a` (corner or centre matrix); with `weight`
+/// non-zero, adds weight * d sample / d a_k to gradient[k]. 0 where a column has zero length.
+double column_sample(const std::array<Vec3, 3>& a, double weight, std::array<Vec3, 3>* gradient) {
+  const double l0 = a[0].norm(), l1 = a[1].norm(), l2 = a[2].norm();
+  const double lengths = l0 * l1 * l2;
+  if (!(lengths > std::numeric_limits<double>::min())) return 0.0;
+  const std::array<Vec3, 3> cofactor = {a[1].cross(a[2]), a[2].cross(a[0]), a[0].cross(a[1])};
+  const double s = a[0].dot(cofactor[0]) / lengths;
+  if (gradient && weight != 0) {
+    const double squared[3] = {l0 * l0, l1 * l1, l2 * l2};
+    for (int k = 0; k < 3; ++k)
+      (*gradient)[k] += weight * (cofactor[k] / lengths - s * a[k] / squared[k]);
+  }
+  return std::clamp(s, -1.0, 1.0);
+}
+
+/// The nine samples of a hex (corners 0..7, centre), as hex_scaled_jacobian_samples orders
+/// them; with `weights`, gradient[v] = sum_s weights[s] d sample_s / d p[v].
+void hex_samples(const Corners& p, std::array<double, 9>& samples,
+                 const std::array<double, 9>* weights = nullptr, Corners* gradient = nullptr) {
+  if (gradient)
+    for (Vec3& g : *gradient) g.setZero();
+  for (int v = 0; v < 8; ++v) {
+    std::array<Vec3, 3> a, g{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    for (int k = 0; k < 3; ++k) {
+      const int e = hex_vertex_edges[v][k];
+      a[k] = p[hex_edges[e][1]] - p[hex_edges[e][0]];
+    }
+    samples[v] = column_sample(a, weights ? (*weights)[v] : 0.0, gradient ? &g : nullptr);
+    if (!gradient) continue;
+    for (int k = 0; k < 3; ++k) {
+      const int e = hex_vertex_edges[v][k];
+      (*gradient)[hex_edges[e][1]] += g[k];
+      (*gradient)[hex_edges[e][0]] -= g[k];
+    }
+  }
+  std::array<Vec3, 3> a, g{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  for (int k = 0; k < 3; ++k) {
+    a[k].setZero();
+    for (int e : hex_axis_edges[k]) a[k] += p[hex_edges[e][1]] - p[hex_edges[e][0]];
+    a[k] /= 4.0;
+  }
+  samples[8] = column_sample(a, weights ? (*weights)[8] : 0.0, gradient ? &g : nullptr);
+  if (!gradient) return;
+  for (int k = 0; k < 3; ++k)
+    for (int e : hex_axis_edges[k]) {
+      (*gradient)[hex_edges[e][1]] += 0.25 * g[k];
+      (*gradient)[hex_edges[e][0]] -= 0.25 * g[k];
+    }
+}
+
+constexpr int64_t chunk_hexes = 512;
+
+/// The samples of a hex that move when the corners marked in `moves` do: bit v (corner v) when
+/// v or one of its three edge neighbours moves, bit 8 (the centre) when any corner does. A sample
+/// that does not move is a constant of the problem: left out of the objective, its value cannot
+/// hold the ascent back.
+uint16_t sample_mask(const std::array<bool, 8>& moves) {
+  uint16_t mask = 0;
+  for (int v = 0; v < 8; ++v) {
+    bool m = moves[v];
+    for (int k = 0; k < 3; ++k) {
+      const int e = hex_vertex_edges[v][k];
+      m = m || moves[hex_edges[e][0]] || moves[hex_edges[e][1]];
+    }
+    if (m) mask |= static_cast<uint16_t>(1u << v);
+  }
+  if (mask) mask |= 1u << 8;
+  return mask;
+}
+
+/// exp(-z), z >= 0, taken as 0 beyond z = 40 (below 5e-18, nothing next to the minimum's 1):
+/// most samples lie far above the minimum, and their exponentials and gradients are skipped.
+double weight(double z) {
+  return z < 40.0 ? std::exp(-z) : 0.0;
+}
+
+class JointProblem {
+ public:
+  JointProblem(HexMesh& mesh, const NodeProblem& problem, const JointAscentOptions& options)
+      : mesh_(mesh), options_(options) {
+    const int32_t n = static_cast<int32_t>(problem.nodes.size());
+    // The variables: the free nodes of the worst hexes within options.band of the worst sample a
+    // free node moves, and of `rings` rings of hexes around them.
+    std::vector<uint8_t> chosen(n, 0);
+    // Per problem hex its worst sample that a free node moves (2: none, never a seed).
+    std::vector<double> quality(problem.hexes.size(), 2.0);
+    double worst = 1.0;
+    for (size_t j = 0; j < problem.hexes.size(); ++j) {
+      std::array<bool, 8> free{};
+      for (int c = 0; c < 8; ++c) {
+        const int32_t i = problem.hex_local_nodes[j][c];
+        free[c] = i >= 0 && problem.slides[i].kind == SlideKind::free;
+      }
+      const uint16_t mask = sample_mask(free);
+      if (!mask) continue;
+      std::array<double, 9> samples;
+      hex_scaled_jacobian_samples(hex_points(mesh_, problem.hexes[j]), samples);
+      for (int k = 0; k < 9; ++k)
+        if (mask >> k & 1) quality[j] = std::min(quality[j], samples[k]);
+      worst = std::min(worst, quality[j]);
+    }
+    // The seeds: within the band, at most max_seeds of them, the worst first (ties by index).
+    std::vector<std::pair<double, int32_t>> seeds;
+    for (size_t j = 0; j < problem.hexes.size(); ++j)
+      if (quality[j] <= 1.0 && quality[j] < worst + options.band)
+        seeds.push_back({quality[j], static_cast<int32_t>(j)});
+    if (static_cast<int64_t>(seeds.size()) > options.max_seeds) {
+      std::nth_element(seeds.begin(), seeds.begin() + options.max_seeds, seeds.end());
+      seeds.resize(static_cast<size_t>(options.max_seeds));
+    }
+    std::vector<int32_t> front;
+    for (const auto& [unused, j] : seeds) {
+      for (int32_t i : problem.hex_local_nodes[j])
+        if (i >= 0 && !chosen[i]) chosen[i] = 1, front.push_back(i);
+    }
+    for (int ring = 0; ring < options.rings; ++ring) {
+      std::vector<int32_t> next;
+      for (int32_t i : front)
+        for (int32_t k = problem.node_hex_offsets[i]; k < problem.node_hex_offsets[i + 1]; ++k)
+          for (int32_t j : problem.hex_local_nodes[problem.node_hex[k]])
+            if (j >= 0 && !chosen[j]) chosen[j] = 1, next.push_back(j);
+      front.swap(next);
+    }
+    std::vector<int32_t> var_of(n, -1);
+    for (int32_t i = 0; i < n; ++i)
+      if (chosen[i] && problem.slides[i].kind == SlideKind::free) {
+        var_of[i] = static_cast<int32_t>(nodes_.size());
+        nodes_.push_back(problem.nodes[i]);
+      }
+    for (size_t j = 0; j < problem.hexes.size(); ++j) {
+      std::array<int32_t, 8> vars;
+      bool any = false;
+      for (int c = 0; c < 8; ++c) {
+        const int32_t i = problem.hex_local_nodes[j][c];
+        vars[c] = i >= 0 ? var_of[i] : -1;
+        any = any || vars[c] >= 0;
+      }
+      if (!any) continue;
+      std::array<bool, 8> moves;
+      for (int c = 0; c < 8; ++c) moves[c] = vars[c] >= 0;
+      hexes_.push_back(problem.hexes[j]);
+      edge_caps_.push_back(
+          hex_edge_ratio_cap(hex_points(mesh_, problem.hexes[j]), options.max_edge_ratio));
+      hex_vars_.push_back(vars);
+      masks_.push_back(sample_mask(moves));
+    }
+    // Variable -> (objective hex, corner), CSR, in hex order.
+    var_offsets_.assign(nodes_.size() + 1, 0);
+    for (const auto& vars : hex_vars_)
+      for (int32_t v : vars)
+        if (v >= 0) ++var_offsets_[v + 1];
+    for (size_t v = 0; v < nodes_.size(); ++v) var_offsets_[v + 1] += var_offsets_[v];
+    var_items_.resize(var_offsets_.back());
+    std::vector<int32_t> cursor(var_offsets_.begin(), var_offsets_.end() - 1);
+    for (size_t h = 0; h < hex_vars_.size(); ++h)
+      for (int c = 0; c < 8; ++c)
+        if (hex_vars_[h][c] >= 0) var_items_[cursor[hex_vars_[h][c]]++] = {int32_t(h), c};
+    samples_.resize(hexes_.size());
+    hex_gradient_.resize(hexes_.size());
+    const int64_t chunks = parallel_chunk_count(static_cast<int64_t>(hexes_.size()), chunk_hexes);
+    chunk_min_.resize(chunks);
+    chunk_sum_.resize(chunks);
+    double edges = 0;
+    for (int32_t h : hexes_) {
+      const Corners p = hex_points(mesh_, h);
+      for (const auto& e : hex_edges) edges += (p[e[1]] - p[e[0]]).norm();
+    }
+    mean_edge_ = hexes_.empty() ? 0.0 : edges / (12.0 * static_cast<double>(hexes_.size()));
+    // Threads start per evaluation: below a few thousand hexes that costs more than it saves.
+    threads_ = hexes_.size() < 8 * chunk_hexes ? 1 : std::max(options.threads, 1);
+  }
+
+  int64_t variables() const { return static_cast<int64_t>(nodes_.size()) * 3; }
+  int64_t hexes() const { return static_cast<int64_t>(hexes_.size()); }
+  double mean_edge() const { return mean_edge_; }
+
+  Eigen::VectorXd position() const {
+    Eigen::VectorXd x(variables());
+    for (size_t v = 0; v < nodes_.size(); ++v) x.segment<3>(3 * v) = mesh_.points[nodes_[v]];
+    return x;
+  }
+  void set_position(const Eigen::VectorXd& x) {
+    for (size_t v = 0; v < nodes_.size(); ++v) mesh_.points[nodes_[v]] = x.segment<3>(3 * v);
+  }
+
+  /// At x: KS (-inf where a sample is not finite or a hex is past its edge-ratio cap: an
+  /// infeasible point), the minimum sample and, with `gradient`,
+  /// d KS / d x.
+  double evaluate(const Eigen::VectorXd& x, double& min, Eigen::VectorXd* gradient) {
+    set_position(x);
+    const int64_t count = static_cast<int64_t>(hexes_.size());
+    parallel_chunks(threads_, count, chunk_hexes, [&](int64_t c, int64_t b, int64_t e) {
+      double m = std::numeric_limits<double>::infinity();
+      for (int64_t h = b; h < e; h += 2) {
+        const int64_t g = std::min(h + 1, e - 1);  // an odd chunk end evaluates its last twice
+        const Corners ph = hex_points(mesh_, hexes_[h]), pg = hex_points(mesh_, hexes_[g]);
+        hex_scaled_jacobian_samples_pair(ph, pg, samples_[h], samples_[g]);
+        // Past its edge-ratio cap a hex makes the point infeasible, like a non-finite sample.
+        constexpr double none = std::numeric_limits<double>::infinity();
+        if ((edge_caps_[h] != none && !(hex_edge_ratio(ph) <= edge_caps_[h])) ||
+            (edge_caps_[g] != none && !(hex_edge_ratio(pg) <= edge_caps_[g])))
+          m = -std::numeric_limits<double>::infinity();
+      }
+      for (int64_t h = b; h < e; ++h)
+        for (int k = 0; k < 9; ++k) {
+          if (!(masks_[h] >> k & 1)) continue;
+          const double s = samples_[h][k];
+          m = std::isfinite(s) ? std::min(m, s) : -std::numeric_limits<double>::infinity();
+        }
+      chunk_min_[c] = m;
+    });
+    min = std::numeric_limits<double>::infinity();
+    for (double m : chunk_min_) min = std::min(min, m);
+    if (!std::isfinite(min)) return -std::numeric_limits<double>::infinity();
+    const double beta = options_.beta;
+    parallel_chunks(threads_, count, chunk_hexes, [&](int64_t c, int64_t b, int64_t e) {
+      double sum = 0;
+      for (int64_t h = b; h < e; ++h)
+        for (int k = 0; k < 9; ++k)
+          if (masks_[h] >> k & 1) sum += weight(beta * (samples_[h][k] - min));
+      chunk_sum_[c] = sum;
+    });
+    double sum = 0;
+    for (double s : chunk_sum_) sum += s;
+    const double ks = min - std::log(sum) / beta;
+    last_min_ = min;
+    last_sum_ = sum;
+    if (gradient) gradient_at_last(*gradient);
+    return ks;
+  }
+
+  /// d KS / d x at the point of the last evaluate() (its samples, minimum and sum).
+  void gradient_at_last(Eigen::VectorXd& gradient) {
+    const int64_t count = static_cast<int64_t>(hexes_.size());
+    const double beta = options_.beta, min = last_min_, sum = last_sum_;
+    parallel_chunks(threads_, count, chunk_hexes, [&](int64_t, int64_t b, int64_t e) {
+      std::array<double, 9> weights, unused;
+      for (int64_t h = b; h < e; ++h) {
+        bool any = false;
+        for (int s = 0; s < 9; ++s) {
+          weights[s] = masks_[h] >> s & 1 ? weight(beta * (samples_[h][s] - min)) / sum : 0.0;
+          any = any || weights[s] != 0;
+        }
+        if (any)
+          hex_samples(hex_points(mesh_, hexes_[h]), unused, &weights, &hex_gradient_[h]);
+        else
+          for (Vec3& g : hex_gradient_[h]) g.setZero();
+      }
+    });
+    gradient.resize(variables());
+    parallel_chunks(threads_, static_cast<int64_t>(nodes_.size()), 4096,
+                    [&](int64_t, int64_t b, int64_t e) {
+                      for (int64_t v = b; v < e; ++v) {
+                        Vec3 g = Vec3::Zero();
+                        for (int32_t k = var_offsets_[v]; k < var_offsets_[v + 1]; ++k)
+                          g += hex_gradient_[var_items_[k].first][var_items_[k].second];
+                        gradient.segment<3>(3 * v) = g;
+                      }
+                    });
+  }
+
+  /// The largest node displacement of the step d.
+  double largest_move(const Eigen::VectorXd& d) const {
+    double largest = 0;
+    for (int64_t v = 0; v < d.size() / 3; ++v)
+      largest = std::max(largest, d.segment<3>(3 * v).norm());
+    return largest;
+  }
+
+  /// The true minimum (hex_scaled_jacobian) over the objective's hexes.
+  double true_min() const {
+    double m = 1.0;
+    for (int32_t h : hexes_) m = std::min(m, hex_scaled_jacobian(hex_points(mesh_, h)));
+    return m;
+  }
+
+ private:
+  HexMesh& mesh_;
+  const JointAscentOptions& options_;
+  std::vector<int32_t> nodes_;                    // variable -> mesh node
+  std::vector<int32_t> hexes_;                    // objective hexes (mesh ids)
+  std::vector<double> edge_caps_;                 // per objective hex: hex_edge_ratio_cap
+  std::vector<std::array<int32_t, 8>> hex_vars_;  // per objective hex: corner variables
+  std::vector<uint16_t> masks_;       // per objective hex: its samples that move (sample_mask)
+  std::vector<int32_t> var_offsets_;  // variable -> var_items_
+  std::vector<std::pair<int32_t, int>> var_items_;  // (objective hex, corner)
+  std::vector<std::array<double, 9>> samples_;      // per objective hex
+  std::vector<Corners> hex_gradient_;               // per objective hex, per corner
+  std::vector<double> chunk_min_, chunk_sum_;
+  double mean_edge_ = 0, last_min_ = 0, last_sum_ = 1;
+  int threads_ = 1;
+};
+
+/// Per problem node: 1 if it, or a problem node sharing a hex with it, is no longer at
+/// `before` (per problem node).
+std::vector<uint8_t> nodes_moved_and_around(const HexMesh& mesh, const NodeProblem& problem,
+                                            const std::vector<Vec3>& before) {
+  const size_t n = problem.nodes.size();
+  std::vector<uint8_t> out(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    if (mesh.points[problem.nodes[i]] == before[i]) continue;
+    for (int32_t k = problem.node_hex_offsets[i]; k < problem.node_hex_offsets[i + 1]; ++k)
+      for (int32_t j : problem.hex_local_nodes[problem.node_hex[k]])
+        if (j >= 0) out[j] = 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+SweepsAndAscentStats nodes_sweep_and_ascend(HexMesh& mesh, const NodeProblem& problem,
+                                            NodeOptimizerOptions sweeps,
+                                            const JointAscentOptions& joint, double ascend_below) {
+  SweepsAndAscentStats stats;
+  const NodeOptimizerStats first = nodes_optimize(mesh, problem, sweeps);
+  stats.sweeps = first.sweeps;
+  if (sweeps.max_sweeps <= 0 || joint.max_iterations <= 0) return stats;
+  if (!(first.min_after < ascend_below)) return stats;
+  std::vector<Vec3> before;
+  before.reserve(problem.nodes.size());
+  for (int32_t v : problem.nodes) before.push_back(mesh.points[v]);
+  const JointAscentStats ascent = nodes_ascend_jointly(mesh, problem, joint);
+  stats.joint_iterations = ascent.iterations;
+  if (!(ascent.min_after > ascent.min_before)) return stats;
+  sweeps.initially_active = nodes_moved_and_around(mesh, problem, before);
+  stats.sweeps += nodes_optimize(mesh, problem, sweeps).sweeps;
+  return stats;
+}
+
+JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
+                                      const JointAscentOptions& options) {
+  JointAscentStats stats;
+  JointProblem joint(mesh, problem, options);
+  stats.free_nodes = joint.variables() / 3;
+  stats.hexes = joint.hexes();
+  if (joint.hexes() == 0 || joint.variables() == 0) return stats;
+  const Eigen::VectorXd start = joint.position();
+  stats.min_before = joint.true_min();
+  stats.min_after = stats.min_before;
+  if (!(stats.min_before > 0) || options.max_iterations <= 0) return stats;
+
+  Eigen::VectorXd x = start, gradient, best = start;
+  double min, best_min;
+  double value = joint.evaluate(x, min, &gradient);
+  if (!std::isfinite(value)) return stats;  // the start past a cap: nothing to ascend from
+  best_min = min;
+  const double cap = 0.25 * joint.mean_edge();
+  std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> history;  // (s, y) of -KS
+  std::vector<double> alpha;
+  int flat = 0, since_best = 0;
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    // Two-loop recursion on f = -KS (gradient -g): direction d = -H (-g).
+    Eigen::VectorXd d = gradient;
+    alpha.assign(history.size(), 0.0);
+    for (int k = static_cast<int>(history.size()) - 1; k >= 0; --k) {
+      const auto& [s, y] = history[k];
+      alpha[k] = s.dot(d) / y.dot(s);
+      d -= alpha[k] * y;
+    }
+    if (!history.empty()) {
+      const auto& [s, y] = history.back();
+      d *= s.dot(y) / y.dot(y);
+    }
+    for (size_t k = 0; k < history.size(); ++k) {
+      const auto& [s, y] = history[k];
+      d += (alpha[k] - y.dot(d) / y.dot(s)) * s;
+    }
+    if (history.empty() || !(d.dot(gradient) > 0)) {
+      history.clear();
+      const double largest = joint.largest_move(gradient);
+      if (!(largest > 0)) break;
+      d = gradient * (0.02 * joint.mean_edge() / largest);
+    }
+    double t = 1.0;
+    const double largest = joint.largest_move(d);
+    if (largest > cap) t = cap / largest;
+    const double slope = d.dot(gradient);
+    Eigen::VectorXd trial, trial_gradient;
+    double trial_value = -std::numeric_limits<double>::infinity(), trial_min = 0;
+    bool accepted = false;
+    for (int halving = 0; halving < 30; ++halving, t *= 0.5) {
+      trial = x + t * d;
+      trial_value = joint.evaluate(trial, trial_min, nullptr);
+      if (trial_value >= value + 1e-4 * t * slope) {
+        accepted = true;
+        break;
+      }
+    }
+    ++stats.iterations;
+    if (!accepted) {
+      if (history.empty()) break;
+      history.clear();  // a poor quasi-Newton model: steepest ascent next
+      continue;
+    }
+    joint.gradient_at_last(trial_gradient);
+    Eigen::VectorXd s = trial - x, y = gradient - trial_gradient;  // y of f = -KS
+    if (s.dot(y) > 1e-12 * s.norm() * y.norm()) {
+      history.emplace_back(std::move(s), std::move(y));
+      if (static_cast<int>(history.size()) > std::max(options.memory, 1)) history.pop_front();
+    }
+    flat = trial_value - value < 1e-9 ? flat + 1 : 0;
+    x = std::move(trial);
+    gradient = std::move(trial_gradient);
+    value = trial_value;
+    if (trial_min > best_min) {
+      since_best = trial_min > best_min + 1e-5 ? 0 : since_best + 1;
+      best_min = trial_min;
+      best = x;
+    } else {
+      ++since_best;
+    }
+    // KS can keep rising by the samples next to the minimum while the minimum itself stays.
+    if (flat >= 5 || since_best >= options.stall_iterations) break;
+  }
+  joint.set_position(best);
+  stats.min_after = joint.true_min();
+  if (stats.min_after < stats.min_before) {
+    joint.set_position(start);
+    stats.min_after = stats.min_before;
+  }
+  return stats;
+}
+
+}  // namespace hexrefine

@@ -1,0 +1,318 @@
+#include "algorithms/refiners/refiner.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <string>
+
+#include "algorithms/placement/smoothing.hpp"
+#include "algorithms/refiners/selective.hpp"
+#include "algorithms/refiners/sheet.hpp"
+#include "mesh/error.hpp"
+#include "mesh/quality.hpp"
+
+namespace hexrefine {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Node placement plans a pass again at most this many times, each with the parents whose
+/// children it could not make valid added to the targets (refine, below).
+constexpr int placement_retries = 3;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+constexpr std::array<RefineMethod, 2> methods = {{
+    {"selective",
+     "the Selective Approach: element-by-element templates, directional refinement with ranking "
+     "and propagation (Parrish)",
+     selective_plan, true},
+    {"sheet", "Harris-style sheet refinement: one dual sheet at a time, targets grown", sheet_plan,
+     false},
+}};
+
+void targets_validate(const HexMesh& mesh, const Targets& targets, std::string_view method) {
+  int32_t previous = -1;
+  for (int32_t t : targets.hexes) {
+    if (t < 0 || t >= mesh.hex_count())
+      throw InputError(std::string(method) + ": target hex " + std::to_string(t) +
+                       " is not in the mesh (0.." + std::to_string(mesh.hex_count() - 1) + ")");
+    if (t <= previous)
+      throw InputError(std::string(method) + ": targets must be ascending and unique (hex " +
+                       std::to_string(t) + " after " + std::to_string(previous) + ")");
+    previous = t;
+  }
+}
+
+/// Refuses an input with hexes of scaled Jacobian <= 0, naming up to ten with their values.
+void input_validate(const HexMesh& mesh, std::string_view method) {
+  int64_t inverted = 0;
+  std::string list;
+  for (int32_t h = 0; h < mesh.hex_count(); ++h) {
+    const double sj = hex_scaled_jacobian(hex_points(mesh, h));
+    if (sj > 0) continue;
+    if (++inverted <= 10)
+      list += (list.empty() ? "" : ", ") + std::to_string(h) + " (" + std::to_string(sj) + ")";
+  }
+  if (inverted)
+    throw InputError(std::string(method) + ": " + std::to_string(inverted) +
+                     " input hexes have a scaled Jacobian <= 0 (inverted or degenerate), no "
+                     "refinement of them can be valid: hex (scaled Jacobian) " +
+                     list + (inverted > 10 ? ", ..." : "") +
+                     " (allow_inverted, --allow-inverted, refines them anyway)");
+}
+
+/// The last resort of node placement (issue 28: no refusal of a valid input). Placement moves
+/// only new nodes; where even the retargets leave children inverted (a transition template in a
+/// parent whose own corners hold a child folded), the nodes around those children move too,
+/// the parents' input nodes included, as smoothing moves them (algorithms/placement/smoothing.hpp:
+/// interior nodes freely, boundary nodes sliding on the input's boundary surface, the mesh's
+/// minimum never lowered, no valid hex inverted, the edge-ratio cap kept): the inverted
+/// children and two layers of hexes around them are the region. Returns empty on success and
+/// counts the children it made valid; throws OperationError naming the input hexes when some
+/// stay inverted: the refinement has no valid placement the tool can find, which says nothing
+/// against the input.
+std::vector<int32_t> placement_fallback_untangle(HexMesh& refined,
+                                                 const BoundaryReference& reference,
+                                                 int32_t input_nodes, const RefineOptions& options,
+                                                 RefineStats& stats) {
+  std::vector<int32_t> inverted;
+  const std::vector<double> before = mesh_scaled_jacobians(refined);
+  for (int32_t h = 0; h < refined.hex_count(); ++h)
+    if (!(before[h] > 0)) inverted.push_back(h);
+  // Validity first: the sweeps visit every node of the region (visit_below 1) and, if the
+  // edge-ratio cap holds a child inverted, run again without it over a wider region (an inverted
+  // child has no quality to protect; a collapsed edge shows in the report's max_edge_ratio).
+  SmoothOptions smoothing;
+  smoothing.region_hexes = inverted;
+  smoothing.layers = 2;
+  smoothing.visit_below = 1;
+  smoothing.reference = &reference;
+  smoothing.reference_nodes = input_nodes;
+  smoothing.threads = options.threads;
+  smoothing.max_edge_ratio = options.placement.max_edge_ratio;
+  mesh_smooth(refined, smoothing);
+  if (std::ranges::any_of(inverted, [&](int32_t h) {
+        return !(hex_scaled_jacobian(hex_points(refined, h)) > 0);
+      })) {
+    smoothing.layers = 4;
+    smoothing.max_edge_ratio = 0;
+    mesh_smooth(refined, smoothing);
+  }
+  const std::vector<double> after = mesh_scaled_jacobians(refined);
+  const std::vector<int32_t>* original = mesh_find_attribute(refined, attribute_parent_hex);
+  std::vector<int32_t> stuck;  // input hexes whose children stay inverted
+  for (int32_t h : inverted) {
+    if (after[h] > 0)
+      ++stats.placement_fallback_untangled;
+    else
+      stuck.push_back(original ? (*original)[h] : h);
+  }
+  if (stuck.empty()) return {};
+  std::sort(stuck.begin(), stuck.end());
+  stuck.erase(std::unique(stuck.begin(), stuck.end()), stuck.end());
+  std::string list;
+  for (size_t i = 0; i < stuck.size() && i < 10; ++i)
+    list += (i ? ", " : "") + std::to_string(stuck[i]);
+  throw OperationError(
+      "node placement: " + std::to_string(stuck.size()) +
+      " refined input hexes keep an inverted child after placement, " +
+      std::to_string(placement_retries) +
+      " retargets and the untangling of the nodes around them (input hexes " + list +
+      (stuck.size() > 10 ? ", ..." : "") +
+      "); the input passed the checker: this is a limit of the placement, not of the input");
+}
+
+}  // namespace
+
+void refine_input_validate(const HexMesh& mesh, const Targets& targets,
+                           const RefineOptions& options, std::string_view method) {
+  targets_validate(mesh, targets, method);
+  if (options.passes < 1)
+    throw InputError(std::string(method) + ": passes must be at least 1, got " +
+                     std::to_string(options.passes));
+  if (options.threads < 1)
+    throw InputError(std::string(method) + ": threads must be at least 1, got " +
+                     std::to_string(options.threads));
+  if (!options.allow_inverted) input_validate(mesh, method);
+}
+
+void stats_count_templates(RefineStats& stats, const std::vector<int32_t>& tags) {
+  // One counter per tag value first: a string-keyed map lookup per hex would cost more than
+  // the refinement itself on large meshes.
+  std::array<int64_t, template_tag_count> known{};
+  for (int32_t t : tags) {
+    if (t >= 0 && t < template_tag_count)
+      ++known[t];
+    else
+      ++stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(t))];
+  }
+  for (int t = 0; t < template_tag_count; ++t)
+    if (known[t])
+      stats.hexes_per_template[template_tag_name(static_cast<TemplateTag>(t))] += known[t];
+}
+
+void refine_stats_finish(RefineStats& stats, const HexMesh& mesh, double seconds) {
+  stats.final_hexes = mesh.hex_count();
+  stats.final_nodes = mesh.point_count();
+  if (const std::vector<int32_t>* tags = mesh_find_attribute(mesh, attribute_template_tag))
+    stats_count_templates(stats, *tags);
+  stats.time_seconds = seconds;
+  stats.phase_seconds["total"] = seconds;
+}
+
+std::span<const RefineMethod> refine_methods() {
+  return methods;
+}
+
+PassBuffer pass_buffer_from_name(std::string_view name) {
+  if (name == "layer") return PassBuffer::layer;
+  if (name == "none") return PassBuffer::none;
+  if (name == "transitions") return PassBuffer::transitions;
+  throw InputError("unknown pass buffer '" + std::string(name) +
+                   "' (expected layer, none or transitions)");
+}
+
+const RefineMethod& refine_method(std::string_view name) {
+  std::string known;
+  for (const RefineMethod& m : methods) {
+    if (m.name == name) return m;
+    known += (known.empty() ? "" : ", ") + std::string(m.name);
+  }
+  throw InputError("unknown refinement method '" + std::string(name) +
+                   "' (expected one of: " + known + ")");
+}
+
+RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targets& targets,
+                    const RefineOptions& options) {
+  const auto t0 = Clock::now();
+  const std::string name(method.name);
+  refine_input_validate(mesh, targets, options, name);
+
+  RefineResult result;
+  RefineStats& stats = result.stats;
+  stats.method = name;
+  stats.initial_hexes = mesh.hex_count();
+  for (const char* phase : {"plan", "apply", "placement"}) stats.phase_seconds[phase] = 0;
+
+  // The mesh a pass refines: the input for the first pass (not copied, its parent_hex dropped
+  // by the engine's rule: the output's parent_hex names the input's hexes), the previous
+  // pass's output after that.
+  HexMesh input_without_parent;
+  const HexMesh* current = &mesh;
+  if (mesh_find_attribute(mesh, attribute_parent_hex)) {
+    input_without_parent = mesh;
+    std::erase_if(input_without_parent.attributes,
+                  [](const HexAttribute& a) { return a.name == attribute_parent_hex; });
+    current = &input_without_parent;
+  }
+  HexMesh output;
+  BoundaryReference reference;  // the input's boundary, where boundary nodes stay
+  // `core`: the descendants of the user's targets in the current mesh (ascending).
+  std::vector<int32_t> core = targets.hexes;
+  const bool layered =
+      method.uses_buffer && options.passes > 1 && options.buffer == PassBuffer::layer;
+  for (int pass = 0; pass < options.passes; ++pass) {
+    auto t = Clock::now();
+    const HexTopology topology = topology_build(*current);
+    std::vector<int32_t> pass_targets = core;
+    if (layered) {
+      std::vector<uint8_t> in_pass(static_cast<size_t>(current->hex_count()), 0);
+      for (int32_t h : core) in_pass[h] = 1;
+      for (int32_t h : core)
+        for (int lf = 0; lf < 6; ++lf) {
+          const int32_t g = hex_face_neighbor(topology, h, lf);
+          if (g >= 0 && !in_pass[g]) {
+            in_pass[g] = 1;
+            pass_targets.push_back(g);
+            ++stats.added_targets;
+          }
+        }
+      std::sort(pass_targets.begin(), pass_targets.end());
+    }
+    // Plan, apply, place. A parent whose children placement cannot make valid (a distorted hex
+    // under a transition template) becomes a target and the pass is planned again: refined by
+    // a template of boxes, its children are images of boxes under its own map, and the
+    // transition moves to its neighbours. At most placement_retries new plans; the counts of a
+    // dropped plan are undone, its time is kept.
+    const RefineStats stats_before_plan = stats;
+    RefinementPlan plan;
+    PlanApplyResult applied;
+    for (int attempt = 0;; ++attempt) {
+      plan = method.plan(*current, topology, pass_targets, options, stats);
+      stats.phase_seconds["plan"] += seconds_since(t);
+
+      t = Clock::now();
+      applied = plan_apply(*current, topology, plan, options.threads,
+                           placement_start_positions(options.placement.method));
+      stats.phase_seconds["apply"] += seconds_since(t);
+
+      t = Clock::now();
+      std::vector<int32_t> failed;
+      if (options.placement.method != PlacementMethod::trilinear) {
+        if (pass == 0 && attempt == 0) reference = boundary_reference_build(*current, topology);
+        const std::vector<int32_t>* original = mesh_find_attribute(*current, attribute_parent_hex);
+        const PlacementPass placement{
+            *current,
+            topology,
+            plan,
+            applied.first_child,
+            original ? std::span<const int32_t>(*original) : std::span<const int32_t>(),
+            reference,
+            options.allow_inverted,
+            false,
+            options.threads,
+            mesh.point_count()};
+        failed = place_new_nodes(placement, applied.mesh, options.placement, stats.placement);
+        if (!failed.empty() && attempt == placement_retries)
+          failed = placement_fallback_untangle(applied.mesh, reference, mesh.point_count(), options,
+                                               stats);
+      }
+      stats.phase_seconds["placement"] += seconds_since(t);
+      if (failed.empty()) break;
+      const std::map<std::string, double> seconds = stats.phase_seconds;
+      const int64_t retargeted = stats.placement_retargets;
+      stats = stats_before_plan;
+      stats.phase_seconds = seconds;
+      stats.placement_retargets = retargeted;
+      const size_t before = pass_targets.size();
+      for (int32_t h : failed)
+        if (!std::binary_search(pass_targets.begin(), pass_targets.begin() + before, h))
+          pass_targets.push_back(h);
+      stats.placement_retargets += static_cast<int64_t>(pass_targets.size() - before);
+      std::sort(pass_targets.begin(), pass_targets.end());
+      // Nothing new to refine: the next plan is the same, so let it refuse.
+      if (pass_targets.size() == before) attempt = placement_retries - 1;
+      t = Clock::now();
+    }
+
+    if (pass + 1 < options.passes) {
+      // The next pass's core: the children of this pass's core (with PassBuffer::transitions
+      // also of every other hex this pass refined, which then count as added targets).
+      std::vector<uint8_t> in_core(static_cast<size_t>(current->hex_count()), 0);
+      for (int32_t h : core) in_core[h] = 1;
+      const bool transitions = method.uses_buffer && options.buffer == PassBuffer::transitions;
+      std::vector<int32_t> next;
+      for (size_t u = 0; u < plan.uses.size(); ++u) {
+        const TemplateUse& use = plan.uses[u];
+        const bool from_core = in_core[index_of(use.hex)];
+        if (!from_core && !transitions) continue;
+        const int32_t first = applied.first_child[u];
+        const int32_t count = static_cast<int32_t>(use.tmpl->children.size());
+        for (int32_t c = first; c < first + count; ++c) next.push_back(c);
+        if (!from_core) stats.added_targets += count;
+      }
+      core = std::move(next);
+    }
+    output = std::move(applied.mesh);
+    current = &output;
+  }
+  result.mesh = std::move(output);
+  refine_stats_finish(stats, result.mesh, seconds_since(t0));
+  return result;
+}
+
+}  // namespace hexrefine

@@ -603,9 +603,9 @@ def targets_table(summary, large, study, records, budget):
                     ", ".join("%s %s step %d" % (r["problem"], r["method"], r["step"])
                               for r in refused) or "none", fmt(not invalid)))
     rows.append("| default study in <= 15 minutes on the 2-core machine | %.0f s wall (%d "
-                "processes at a time, shared machine), %.0f s CPU | %s |" % (
-                    study["wall_seconds"], study["jobs"], study["cpu_seconds"],
-                    fmt(study["wall_seconds"] <= 900)))
+                "processes at a time, load average %.1f at the start), %.0f s CPU | %s |" % (
+                    study["wall_seconds"], study["jobs"], study.get("load_start", float("nan")),
+                    study["cpu_seconds"], fmt(study["wall_seconds"] <= 900)))
     return "\n".join(rows)
 
 

@@ -63,7 +63,9 @@ def test_the_estimator_is_zero_for_a_solution_in_the_q1_space(case):
     assert eta2.shape == (mesh.hex_count,)
     assert eta2.max() < 1e-18
     e_h1, e_l2 = poisson.errors(solution, problem)
-    assert e_h1 < 1e-9 and e_l2 < 1e-9
+    # CG stops at a relative residual of 1e-10 (poisson.SolverOptions.rtol): the error is the
+    # solver's, of that order (1.8e-9 in H1 on the graded transitions), not the space's.
+    assert e_h1 < 1e-8 and e_l2 < 1e-8
     # The same estimator is not zero where u is not in the space.
     other = q1_problem(lambda x: x[0]**2 - x[1]**2)
     assert poisson.indicators(solve_on(mesh, other), other).sum() > 1e-3

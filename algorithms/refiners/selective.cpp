@@ -260,11 +260,12 @@ RefinementPlan SelectivePass::assemble() {
     } else if (role_[h] == kDirectional) {
       const std::vector<TemplateCell>& cells = cells_[directional_index_[h]];
       if (cells.size() == 1 && cells[0].whole) continue;
-      // The table's positions are reference positions: the thesis' placement needs none.
-      plan.owned.push_back(
-          selective_cells_template(cells, TemplateTag::directional, cells_refiner_,
-                                   options_.placement.configuration_table &&
-                                       options_.placement.method != PlacementMethod::trilinear));
+      // The table's positions are reference positions: the thesis' placement needs none, nor
+      // the children's quality at them.
+      const bool placed = options_.placement.method != PlacementMethod::trilinear;
+      plan.owned.push_back(selective_cells_template(cells, TemplateTag::directional, cells_refiner_,
+                                                    options_.placement.configuration_table,
+                                                    placed));
       use.tmpl = plan.owned.back().get();
     } else {
       continue;

@@ -213,7 +213,7 @@ void CellRefiner::refine(const TemplateCell& cell, const HexTemplate& t, int sym
 
 std::unique_ptr<HexTemplate> selective_cells_template(const std::vector<TemplateCell>& cells,
                                                       TemplateTag tag, const CellRefiner& refiner,
-                                                      bool configuration_table) {
+                                                      bool configuration_table, bool placed) {
   auto t = std::make_unique<HexTemplate>();
   t->tag = tag;
   std::unordered_map<NodeKey, int16_t, NodeKeyHash> index;
@@ -224,18 +224,20 @@ std::unique_ptr<HexTemplate> selective_cells_template(const std::vector<Template
       const auto [it, inserted] = index.emplace(c.key[v], static_cast<int16_t>(t->nodes.size()));
       if (inserted) {
         TemplateNode n{c.ref[v]};
-        n.shared = refiner.is_alias_target(c.key[v]);
+        if (placed) {
+          n.shared = refiner.is_alias_target(c.key[v]);
+          t->reference.push_back(c.place[v]);
+          moved = moved || c.place[v] != c.ref[v];
+        }
         t->nodes.push_back(n);
-        t->reference.push_back(c.place[v]);
-        moved = moved || c.place[v] != c.ref[v];
       }
       child[v] = it->second;
     }
     t->children.push_back(child);
   }
   if (!moved) t->reference.clear();
-  if (configuration_table) template_reference_from_configurations(*t);
-  template_compile(*t, 1);
+  if (configuration_table && placed) template_reference_from_configurations(*t);
+  template_compile(*t, 1, placed);
   return t;
 }
 

@@ -87,9 +87,12 @@ class CellRefiner {
 /// children the cells, tag `tag`; compiled for symmetry 0 only. Reference positions: the cells'
 /// composed `place` corners, the movable nodes (strictly inside, no alias target of `refiner`,
 /// which are TemplateNode::shared) from the committed table of directional configurations when
-/// it lists this one and `configuration_table` is set (template_reference.hpp).
+/// it lists this one and `configuration_table` is set (template_reference.hpp). Without
+/// `placed` (the thesis' trilinear placement) neither reference positions nor the children's
+/// quality at them are made: the template holds the exact positions alone.
 std::unique_ptr<HexTemplate> selective_cells_template(const std::vector<TemplateCell>& cells,
                                                       TemplateTag tag, const CellRefiner& refiner,
-                                                      bool configuration_table = true);
+                                                      bool configuration_table = true,
+                                                      bool placed = true);
 
 }  // namespace hexrefine

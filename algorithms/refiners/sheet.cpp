@@ -379,9 +379,8 @@ RefinementPlan sheet_plan(const HexMesh& mesh, const HexTopology& topology,
     const uint32_t key = marks | (rank[0] + 1) << 8 | (rank[1] + 1) << 10 | (rank[2] + 1) << 12;
     if (!composites[key]) {
       composites[key] =
-          sheet_composite_build(marks, rank, h,
-                                options.placement.configuration_table &&
-                                    options.placement.method != PlacementMethod::trilinear);
+          sheet_composite_build(marks, rank, h, options.placement.configuration_table,
+                                options.placement.method != PlacementMethod::trilinear);
       if (!composites[key]->positive)
         throw OperationError("sheet refinement: the refinement of input hex " + std::to_string(h) +
                              " is inverted even on the reference cube");

@@ -248,7 +248,8 @@ RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int3
 
 std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
                                                       const std::array<int8_t, 3>& rank,
-                                                      int32_t input_hex, bool configuration_table) {
+                                                      int32_t input_hex, bool configuration_table,
+                                                      bool placed) {
   const std::vector<int32_t> color = {0, 1, 2};
   const int32_t rounds = 1 + std::max({rank[0], rank[1], rank[2]});
   auto c = std::make_unique<SheetComposite>();
@@ -281,21 +282,21 @@ std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
     return cube;
   };
   const HexMesh cube = run(TemplatePositions::exact, true);
-  const HexMesh placed = run(TemplatePositions::reference, false);
+  const HexMesh at_reference = placed ? run(TemplatePositions::reference, false) : cube;
   c->tmpl = std::make_unique<HexTemplate>();
   HexTemplate& t = *c->tmpl;
   t.tag = TemplateTag::sheet;
   for (const Eigen::Vector3d& x : cube.points) t.nodes.push_back({{x[0], x[1], x[2]}});
-  if (placed.points != cube.points)
-    for (const Eigen::Vector3d& x : placed.points) t.reference.push_back({x[0], x[1], x[2]});
+  if (at_reference.points != cube.points)
+    for (const Eigen::Vector3d& x : at_reference.points) t.reference.push_back({x[0], x[1], x[2]});
   for (int32_t h = 0; h < cube.hex_count(); ++h) {
     std::array<int16_t, 8> child{};
     for (int k = 0; k < 8; ++k) child[k] = static_cast<int16_t>(cube.hexes[h][k]);
     t.children.push_back(child);
     c->positive = c->positive && hex_corners_positive(hex_points(cube, h));
   }
-  if (configuration_table) template_reference_from_configurations(t);
-  template_compile(t, 1);
+  if (configuration_table && placed) template_reference_from_configurations(t);
+  template_compile(t, 1, placed);
   composite_face_hashes(t, c->face_hash);
   return c;
 }

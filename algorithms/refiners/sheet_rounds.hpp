@@ -62,7 +62,9 @@ RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int3
 /// exact grid, compiled for symmetry 0; its reference positions the rounds run again with the
 /// directional templates' reference positions, so the face rules of template_reference.hpp
 /// compose as in the Selective Approach's directional hexes; its movable nodes from the table
-/// of configurations when `configuration_table` is set and the table lists it), with the hashes of
+/// of configurations when `configuration_table` is set and the table lists it; without `placed`,
+/// the thesis' trilinear placement, no reference positions and no children's quality at them), with
+/// the hashes of
 /// its six face subdivisions per face frame (face_hash[lf][2 * i0 + (step == 1 ? 0 : 1)]: origin at
 /// position i0 of hex_faces[lf], u towards i0 + step) so neighbours can be compared before anything
 /// is applied.
@@ -75,7 +77,8 @@ struct SheetComposite {
 std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
                                                       const std::array<int8_t, 3>& rank,
                                                       int32_t input_hex,
-                                                      bool configuration_table = true);
+                                                      bool configuration_table = true,
+                                                      bool placed = true);
 
 /// Hash of an unrefined face (any frame).
 uint64_t sheet_whole_face_hash();

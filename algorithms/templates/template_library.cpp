@@ -477,7 +477,7 @@ void template_compute_child_axes(HexTemplate& t) {
     for (int k = 0; k < 3; ++k) t.child_axis[c][k] = root_class[find(3 * c + k)];
 }
 
-void template_compile(HexTemplate& t, int symmetry_count) {
+void template_compile(HexTemplate& t, int symmetry_count, bool child_quality) {
   constexpr int64_t unit = template_param_unit, sixth = unit / 6;
   if (!t.reference.empty() && t.reference.size() != t.nodes.size())
     throw OperationError(std::string("template ") + template_tag_name(t.tag) + ": " +
@@ -485,15 +485,16 @@ void template_compile(HexTemplate& t, int symmetry_count) {
                          std::to_string(t.nodes.size()) + " nodes");
   t.child_reference_quality.clear();
   t.reference_edge_ratio = 1;
-  for (const auto& child : t.children) {
-    HexCorners x;
-    for (int k = 0; k < 8; ++k) {
-      const auto& r = template_node_reference(t, static_cast<size_t>(child[k]));
-      x[k] = Eigen::Vector3d(r[0], r[1], r[2]);
+  if (child_quality)
+    for (const auto& child : t.children) {
+      HexCorners x;
+      for (int k = 0; k < 8; ++k) {
+        const auto& r = template_node_reference(t, static_cast<size_t>(child[k]));
+        x[k] = Eigen::Vector3d(r[0], r[1], r[2]);
+      }
+      t.child_reference_quality.push_back(hex_scaled_jacobian(x));
+      t.reference_edge_ratio = std::max(t.reference_edge_ratio, hex_edge_ratio(x));
     }
-    t.child_reference_quality.push_back(hex_scaled_jacobian(x));
-    t.reference_edge_ratio = std::max(t.reference_edge_ratio, hex_edge_ratio(x));
-  }
   t.plans.assign(static_cast<size_t>(symmetry_count), {});
   for (int sym = 0; sym < symmetry_count; ++sym) {
     const CubeSymmetry& s = cube_symmetries()[sym];

@@ -134,11 +134,13 @@ inline const std::array<double, 3>& template_node_reference(const HexTemplate& t
 /// Fills tmpl.child_axis.
 void template_compute_child_axes(HexTemplate& tmpl);
 
-/// Fills tmpl.plans for symmetries 0 .. symmetry_count - 1 (48: all) and
-/// tmpl.child_reference_quality. Throws OperationError if a
+/// Fills tmpl.plans for symmetries 0 .. symmetry_count - 1 (48: all) and, with
+/// `child_quality`, tmpl.child_reference_quality and tmpl.reference_edge_ratio (what placement
+/// other than trilinear reads; a plan for the thesis' trilinear placement skips them: a scaled
+/// Jacobian and an edge ratio per child of every directional hex). Throws OperationError if a
 /// node off the exact grid is not strictly inside the cube (it could not be shared with a
 /// neighbour), or if tmpl.reference is neither empty nor one position per node.
-void template_compile(HexTemplate& tmpl, int symmetry_count = 48);
+void template_compile(HexTemplate& tmpl, int symmetry_count = 48, bool child_quality = true);
 
 /// The standard templates in canonical orientation, compiled for all 48 symmetries.
 /// 1-27: all twelve edges split; 3 x 3 x 3 children.

@@ -188,7 +188,21 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     r.stats.initial_hexes = r.stats.final_hexes = input.hex_count();
     r.stats.final_nodes = input.point_count();
   } else {
-    RefineResult refined = refine(method, input, Targets{r.selected}, o.refine);
+    RefineResult refined;
+    try {
+      refined = refine(method, input, Targets{r.selected}, o.refine);
+    } catch (const OperationError& e) {
+      // `untangle` keeps the thesis' positions, the better start for smoothing, but on a
+      // distorted input they can leave a child no untangling saves (ecr_cap.mesh, two passes:
+      // real_meshes.md); `optimized` starts from the reference positions and may not. The
+      // counts can differ (placement retargets), never the validity.
+      if (!o.smooth || o.refine.placement.method != PlacementMethod::untangle) throw;
+      RefineOptions optimized = o.refine;
+      optimized.placement.method = PlacementMethod::optimized;
+      refined = refine(method, input, Targets{r.selected}, optimized);
+      r.placement_warning = std::string("the untangle start was refused (") + e.what() +
+                            "); placed by optimized instead";
+    }
     r.mesh = std::move(refined.mesh);
     r.stats = std::move(refined.stats);
   }
@@ -414,6 +428,7 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
   if (!r.selection_warning.empty()) selection["warning"] = r.selection_warning;
   j["selection"] = selection;
   j["refine"] = r.stats;
+  if (!r.placement_warning.empty()) j["refine"]["placement_warning"] = r.placement_warning;
   j["refined_parents"] = {{"hexes", r.refined_parents},
                           {"min_scaled_jacobian", r.refined_parents_min_scaled_jacobian},
                           {"children_min_scaled_jacobian", r.children_min_scaled_jacobian}};

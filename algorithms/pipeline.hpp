@@ -83,6 +83,10 @@ struct PipelineResult {
   RefineStats stats;
   std::vector<int32_t> selected;  ///< the targets, ascending
   std::string selection_warning;  ///< non-empty when the selection matched nothing
+  /// Non-empty when the smoothing start (`untangle`, the thesis' positions) was refused and the
+  /// refinement was placed by `optimized` instead (what it said, and that): a valid input is
+  /// never refused for the start its smoothing prefers (report: refine.placement_warning).
+  std::string placement_warning;
   /// Input hexes that were refined (their children's refinement level is above theirs) and their
   /// lowest scaled Jacobian (1 if none): what a refinement's quality is fairly
   /// compared with.

@@ -111,6 +111,8 @@ int refine_run(const CliArgs& a) {
   if (!r.selection_warning.empty())
     std::cerr << "hexrefine refine: warning: " << r.selection_warning
               << "; the mesh was written unchanged\n";
+  if (!r.placement_warning.empty())
+    std::cerr << "hexrefine refine: warning: " << r.placement_warning << "\n";
   if (!r.smoothing_warning.empty())
     std::cerr << "hexrefine refine: warning: " << r.smoothing_warning << "\n";
   if (report_path) {

@@ -210,8 +210,10 @@ def targets_section(rows):
         mine = [s for s in done if s["arm"] == arm and s[key] is not None]
         compared = [s for s in mine if (s["folder"], s["mesh"], s["kind"], s["method"])
                     in trilinear_ratio]
+        # 1e-6: the placement's guard compares edge lengths the scaled-Jacobian kernel read, the
+        # checker computes them again (20.0000053 at most over the study).
         over = [s for s in compared if s[key] > max(20.0, trilinear_ratio[
-            (s["folder"], s["mesh"], s["kind"], s["method"])]) * (1 + 1e-9)]
+            (s["folder"], s["mesh"], s["kind"], s["method"])]) * (1 + 1e-6)]
         row("edge-ratio cap held, %s: largest edge ratio <= max(20, the trilinear output's)" % (
             "default placement" if arm == "default" else "`--smooth`"),
             "%d of %d (%d without a trilinear output to compare)%s" % (

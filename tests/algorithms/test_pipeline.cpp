@@ -153,5 +153,28 @@ TEST(Pipeline, PlacementFallbackMakesAFormerRefusalValid) {
             r.stats.placement_fallback_untangled);
 }
 
+// Issue 28: --smooth never refuses a valid input for its start. On ecr_cap.mesh, two selective
+// passes under the layer rule, the thesis' positions (`untangle`, the start smoothing prefers)
+// leave a child of input hex 3733 that no untangling saves; the pipeline then places the
+// refinement with `optimized` (reference positions first), says so, and smooths from there.
+TEST(Pipeline, SmoothingStartRefusedFallsBackToOptimizedPlacement) {
+  const HexMesh input = mesh_read(shared_mesh("ecr_cap.mesh"));
+  PipelineOptions o;
+  o.select = {"sphere:5.81974,13.5306,14.1117,4.07633"};
+  o.refine.passes = 2;
+  o.refine.buffer = PassBuffer::layer;
+  o.smooth = true;
+  o.refine.placement.method = pipeline_default_placement(o.smooth);
+  const PipelineResult r = pipeline_run(input, o);
+  EXPECT_TRUE(r.check.valid());
+  ASSERT_TRUE(r.smoothed_check);
+  EXPECT_TRUE(r.smoothed_check->valid());
+  EXPECT_GE(r.smoothed_check->min_scaled_jacobian, r.check.min_scaled_jacobian);
+  EXPECT_EQ(r.stats.final_hexes, 206212);
+  EXPECT_NE(r.placement_warning.find("input hexes 3733"), std::string::npos) << r.placement_warning;
+  EXPECT_NE(r.placement_warning.find("placed by optimized instead"), std::string::npos);
+  EXPECT_EQ(pipeline_report(r, o).at("refine").at("placement_warning"), r.placement_warning);
+}
+
 }  // namespace
 }  // namespace hexrefine

@@ -191,7 +191,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     RefineResult refined;
     try {
       refined = refine(method, input, Targets{r.selected}, o.refine);
-    } catch (const OperationError& e) {
+    } catch (const PlacementError& e) {
       // `untangle` keeps the thesis' positions, the better start for smoothing, but on a
       // distorted input they can leave a child no untangling saves (ecr_cap.mesh, two passes:
       // real_meshes.md); `optimized` starts from the reference positions and may not. The
@@ -200,6 +200,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
       RefineOptions optimized = o.refine;
       optimized.placement.method = PlacementMethod::optimized;
       refined = refine(method, input, Targets{r.selected}, optimized);
+      r.placement_used = PlacementMethod::optimized;
       r.placement_warning = std::string("the untangle start was refused (") + e.what() +
                             "); placed by optimized instead";
     }
@@ -419,6 +420,7 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
   j["schema_version"] = pipeline_report_schema_version;
   j["method"] = o.method;
   j["options"] = o.refine;
+  if (r.placement_used) j["options"]["placement"]["method"] = *r.placement_used;
   j["options"]["smooth"] = o.smooth;
   nlohmann::json selection = {{"hexes", r.selected.size()}};
   if (o.targets)

@@ -87,6 +87,9 @@ struct PipelineResult {
   /// refinement was placed by `optimized` instead (what it said, and that): a valid input is
   /// never refused for the start its smoothing prefers (report: refine.placement_warning).
   std::string placement_warning;
+  /// The placement the refinement was placed by when it is not the options' (see above); the
+  /// report's options.placement.method names it.
+  std::optional<PlacementMethod> placement_used;
   /// Input hexes that were refined (their children's refinement level is above theirs) and their
   /// lowest scaled Jacobian (1 if none): what a refinement's quality is fairly
   /// compared with.

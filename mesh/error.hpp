@@ -23,6 +23,14 @@ class OperationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Node placement could not make every child of a valid input valid (after its retargets and
+/// fallback): a limit of the placement method, not of the input. The pipeline may try another
+/// placement (algorithms/pipeline.cpp).
+class PlacementError : public OperationError {
+ public:
+  using OperationError::OperationError;
+};
+
 /// "file:line: message" (line 0 is left out: the error concerns the whole file).
 std::string error_at(const std::string& file, int64_t line, const std::string& message);
 

@@ -443,9 +443,11 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
   const auto& uses = pass.plan.uses;
   auto original = [&](int32_t h) { return pass.original_of.empty() ? h : pass.original_of[h]; };
 
-  // 0. Parents the reference positions stretch past the cap at their exact positions; in a
-  // later pass, boundary new nodes onto the input's boundary patches.
-  stats.exact_parents += parents_past_cap_to_exact(pass, refined, options.max_edge_ratio);
+  // 0. Parents the reference positions stretch past the cap at their exact positions (nothing
+  // to do where the start is the exact positions); in a later pass, boundary new nodes onto the
+  // input's boundary patches.
+  if (placement_start_positions(options.method) == TemplatePositions::reference)
+    stats.exact_parents += parents_past_cap_to_exact(pass, refined, options.max_edge_ratio);
   if (pass.input_nodes < old_nodes) boundary_nodes_project(pass, refined);
   if (options.method == PlacementMethod::reference) return {};
 
@@ -757,7 +759,7 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
     list += (i ? ", " : "") + std::to_string(original(h)) + " (" +
             std::to_string(parent_quality[failed[i]]) + ")";
   }
-  throw OperationError(
+  throw PlacementError(
       "node placement: no placement of the new nodes gives every child a "
       "positive scaled Jacobian in input hexes (scaled Jacobian) " +
       list + (failed.size() > 10 ? ", ..." : "") +

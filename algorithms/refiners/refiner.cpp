@@ -117,7 +117,7 @@ std::vector<int32_t> placement_fallback_untangle(HexMesh& refined,
   std::string list;
   for (size_t i = 0; i < stuck.size() && i < 10; ++i)
     list += (i ? ", " : "") + std::to_string(stuck[i]);
-  throw OperationError(
+  throw PlacementError(
       "node placement: " + std::to_string(stuck.size()) +
       " refined input hexes keep an inverted child after placement, " +
       std::to_string(placement_retries) +

@@ -173,7 +173,11 @@ TEST(Pipeline, SmoothingStartRefusedFallsBackToOptimizedPlacement) {
   EXPECT_EQ(r.stats.final_hexes, 206212);
   EXPECT_NE(r.placement_warning.find("input hexes 3733"), std::string::npos) << r.placement_warning;
   EXPECT_NE(r.placement_warning.find("placed by optimized instead"), std::string::npos);
-  EXPECT_EQ(pipeline_report(r, o).at("refine").at("placement_warning"), r.placement_warning);
+  ASSERT_TRUE(r.placement_used);
+  EXPECT_EQ(*r.placement_used, PlacementMethod::optimized);
+  const nlohmann::json j = pipeline_report(r, o);
+  EXPECT_EQ(j.at("refine").at("placement_warning"), r.placement_warning);
+  EXPECT_EQ(j.at("options").at("placement").at("method"), "optimized");
 }
 
 }  // namespace

@@ -115,6 +115,28 @@ struct NodeOrigin {
   int16_t plan_node = -1;
 };
 
+/// The input hex of hex h of the pass's mesh (h itself in the first pass).
+int32_t pass_original(const PlacementPass& pass, int32_t h) {
+  return pass.original_of.empty() ? h : pass.original_of[h];
+}
+
+/// Into `around`: the input hexes of the boundary around new node `pn` of a template on hex h
+/// (its parent's face if that face is on the boundary, the hexes around its parent's edge if
+/// that edge is); empty for a node inside its parent or on an interior face or edge.
+void boundary_input_hexes_around(const PlacementPass& pass, int32_t h, const TemplatePlanNode& pn,
+                                 std::vector<int32_t>& around) {
+  const HexTopology& topology = pass.topology;
+  around.clear();
+  if (pn.entity == CubeEntity::face) {
+    if (face_is_boundary(topology, topology.hex_face_ids[h][pn.local]))
+      around.push_back(pass_original(pass, h));
+  } else if (pn.entity == CubeEntity::edge) {
+    const int32_t e = topology.hex_edge_ids[h][pn.local];
+    if (edge_is_boundary(topology, e))
+      for (int32_t g : edge_hexes(topology, e)) around.push_back(pass_original(pass, g));
+  }
+}
+
 /// Step 0 (see the file comment): the parents whose children at the reference positions exceed
 /// the edge-ratio cap (max(cap, what the exact positions give the child)) get every new node of
 /// theirs at its exact position instead, except the nodes an alias gives to an adjusting hex;
@@ -213,7 +235,6 @@ int64_t parents_past_cap_to_exact(const PlacementPass& pass, HexMesh& refined, d
 void boundary_nodes_project(const PlacementPass& pass, HexMesh& refined) {
   const HexTopology& topology = pass.topology;
   const int32_t old_nodes = pass.current.point_count();
-  auto original = [&](int32_t h) { return pass.original_of.empty() ? h : pass.original_of[h]; };
   SlideGeometry geometry;
   ReferenceSlides slides(pass.reference, geometry);
   std::vector<uint8_t> done(refined.points.size() - static_cast<size_t>(old_nodes), 0);
@@ -231,16 +252,7 @@ void boundary_nodes_project(const PlacementPass& pass, HexMesh& refined) {
         const int32_t node = refined.hexes[pass.first_child[u] + static_cast<int32_t>(c)][k];
         if (node < old_nodes || done[node - old_nodes]) continue;
         done[node - old_nodes] = 1;
-        const TemplatePlanNode& pn = plan.nodes[plan.children[c][k]];
-        around.clear();
-        if (pn.entity == CubeEntity::face) {
-          if (face_is_boundary(topology, topology.hex_face_ids[h][pn.local]))
-            around.push_back(original(h));
-        } else if (pn.entity == CubeEntity::edge) {
-          const int32_t e = topology.hex_edge_ids[h][pn.local];
-          if (edge_is_boundary(topology, e))
-            for (int32_t g : edge_hexes(topology, e)) around.push_back(original(g));
-        }
+        boundary_input_hexes_around(pass, h, plan.nodes[plan.children[c][k]], around);
         if (around.empty()) continue;
         std::sort(around.begin(), around.end());
         around.erase(std::unique(around.begin(), around.end()), around.end());
@@ -441,7 +453,7 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
   const HexTopology& topology = pass.topology;
   const int32_t old_nodes = current.point_count();
   const auto& uses = pass.plan.uses;
-  auto original = [&](int32_t h) { return pass.original_of.empty() ? h : pass.original_of[h]; };
+  auto original = [&](int32_t h) { return pass_original(pass, h); };
 
   // 0. Parents the reference positions stretch past the cap at their exact positions (nothing
   // to do where the start is the exact positions); in a later pass, boundary new nodes onto the
@@ -665,15 +677,7 @@ std::vector<int32_t> place_new_nodes(const PlacementPass& pass, HexMesh& refined
           const int32_t h = index_of(use.hex);
           const TemplatePlanNode& pn = use.tmpl->plans[use.symmetry].nodes[o.plan_node];
           // On the boundary of the refined mesh: the input hexes around the node's entity.
-          around.clear();
-          if (pn.entity == CubeEntity::face) {
-            if (face_is_boundary(topology, topology.hex_face_ids[h][pn.local]))
-              around.push_back(original(h));
-          } else if (pn.entity == CubeEntity::edge) {
-            const int32_t e = topology.hex_edge_ids[h][pn.local];
-            if (edge_is_boundary(topology, e))
-              for (int32_t g : edge_hexes(topology, e)) around.push_back(original(g));
-          }
+          boundary_input_hexes_around(pass, h, pn, around);
           NodeSlide slide;
           if (!around.empty()) {
             const std::optional<NodeSlide> s = slides.at(refined.points[node], around);

@@ -1,7 +1,9 @@
 /// \file
-/// `hexrefine check MESH [--reference REF] [--report R.json] [--sheets] [--threads N]`: reads a
-/// hex mesh, runs the conformity and validity checks of mesh/conformity.hpp (against REF, the mesh
-/// before refinement, if given), counts the dual sheets with --sheets, prints a summary and
+/// `hexrefine check MESH [--reference REF] [--report R.json] [--sheets] [--worst K] [--threads N]`:
+/// reads a hex mesh, runs the conformity and validity checks of mesh/conformity.hpp (against REF,
+/// the mesh before refinement, if given), counts the dual sheets with --sheets, lists the K hexes
+/// of lowest scaled Jacobian with their boundary faces and cell attributes (which template and
+/// which input hex a refinement made them from) with --worst, prints a summary and
 /// writes the JSON report (with the wall and CPU time of each stage and the peak memory;
 /// --verbose prints the wall time and the peak per stage).
 /// Exit codes: 0 valid (conformal, no inverted hex, geometry preserved when compared), 1 defects
@@ -14,6 +16,7 @@
 #include <optional>
 
 #include "algorithms/pipeline.hpp"
+#include "algorithms/templates/template_library.hpp"
 #include "experiments/cli.hpp"
 #include "experiments/process_huge_pages.hpp"
 #include "mesh/atomic_file.hpp"
@@ -22,6 +25,7 @@
 #include "mesh/error.hpp"
 #include "mesh/io.hpp"
 #include "mesh/topology.hpp"
+#include "mesh/worst_hexes.hpp"
 
 namespace hexrefine {
 
@@ -94,6 +98,23 @@ int check_run(const CliArgs& a) {
     json["self_intersecting_sheets"] = *self_intersecting;
     stage_end("sheets");
   }
+  std::vector<WorstHex> worst;
+  if (const auto k = a.value("--worst")) {
+    worst =
+        mesh_worst_hexes(mesh, static_cast<int>(cli_parse_int_in(*k, 1, 1000, "--worst")), threads);
+    nlohmann::json list = nlohmann::json::array();
+    for (const WorstHex& w : worst) {
+      nlohmann::json attributes = nlohmann::json::object();
+      for (const HexAttribute& attribute : mesh.attributes)
+        attributes[attribute.name] = attribute.values[w.hex];
+      list.push_back({{"hex", w.hex},
+                      {"scaled_jacobian", w.scaled_jacobian},
+                      {"boundary_faces", w.boundary_faces},
+                      {"attributes", attributes}});
+    }
+    json["worst_hexes"] = list;
+    stage_end("worst");
+  }
   json["stage_seconds"] = stage_seconds;
   json["stage_cpu_seconds"] = stage_cpu_seconds;
   json["peak_memory_mb"] = process_peak_memory_mb();
@@ -116,6 +137,15 @@ int check_run(const CliArgs& a) {
         << (report.reference_planar_faced ? " (planar-faced: must be preserved)"
                                           : " (reference not planar-faced: reported only)")
         << "\n";
+  for (const WorstHex& w : worst) {
+    out << "  worst: hex " << w.hex << ", scaled Jacobian " << format_number(w.scaled_jacobian)
+        << ", " << w.boundary_faces << " boundary face" << (w.boundary_faces == 1 ? "" : "s");
+    if (const std::vector<int32_t>* tag = mesh_find_attribute(mesh, attribute_template_tag))
+      out << ", template " << template_tag_name(static_cast<TemplateTag>((*tag)[w.hex]));
+    if (const std::vector<int32_t>* parent = mesh_find_attribute(mesh, attribute_parent_hex))
+      out << ", from input hex " << (*parent)[w.hex];
+    out << "\n";
+  }
   if (report.duplicate_nodes > 0)
     out << "  note: " << report.duplicate_nodes << " duplicate nodes\n";
   if (report.unused_nodes > 0) out << "  note: " << report.unused_nodes << " unused nodes\n";
@@ -147,6 +177,9 @@ const CliCommand cli_check_command = {
          "the mesh before refinement: compare boundary, volume and area with it"},
         {"--report", "R.json", "write the JSON report"},
         {"--sheets", "", "also count the dual sheets (builds the full topology: slower)"},
+        {"--worst", "K",
+         "list the K hexes (1..1000) of lowest scaled Jacobian: boundary faces, template, "
+         "input hex"},
         {"--threads", "N", "threads for the check, 1..256 (same report; default: every core)"},
         {"--verbose", "", "print each stage's time on stderr as it ends"},
     },

@@ -201,6 +201,45 @@ TEST(CliCheck, OctreeSplitBesideUnsplitHex) {
   }
 }
 
+TEST(CliCheck, WorstHexesNameTheirPlaceTemplateAndParent) {
+  // Rockerarm refined around one sphere: the worst hexes are children, each named with its
+  // template and input hex, and the list is the report's too.
+  const auto dir = test_temp_dir("cli_check_worst");
+  const std::string refined = (dir / "refined.vtu").string();
+  const CliRun refine = cli_run("refine " + shared_mesh("rockerarm.mesh") + " " + refined +
+                                " --method selective --select sphere:0,0,0,5 --threads 1");
+  ASSERT_EQ(refine.exit_code, 0) << refine.output;
+  const auto report = dir / "r.json";
+  const CliRun run = cli_run("check " + refined + " --worst 4 --report " + report.string());
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = read_json(report);
+  ASSERT_EQ(j["worst_hexes"].size(), 4u);
+  EXPECT_EQ(j["worst_hexes"][0]["scaled_jacobian"], j["min_scaled_jacobian"]);
+  for (size_t k = 0; k < 4; ++k) {
+    const nlohmann::json& w = j["worst_hexes"][k];
+    if (k > 0) {
+      EXPECT_GE(w["scaled_jacobian"], j["worst_hexes"][k - 1]["scaled_jacobian"]);
+    }
+    EXPECT_GE(w["boundary_faces"].get<int>(), 0);
+    EXPECT_LE(w["boundary_faces"].get<int>(), 3);
+    EXPECT_GE(w["attributes"]["refinement_level"].get<int>(), 1);  // a child, not an input hex
+    EXPECT_GT(w["attributes"]["template_tag"].get<int>(), 0);
+    EXPECT_NE(
+        run.output.find("worst: hex " + std::to_string(w["hex"].get<int>()) + ", scaled Jacobian"),
+        std::string::npos)
+        << run.output;
+  }
+  EXPECT_NE(run.output.find(", template "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(", from input hex "), std::string::npos) << run.output;
+  EXPECT_TRUE(j["stage_seconds"].contains("worst"));
+  // Without the option: no list.
+  const auto plain = dir / "plain.json";
+  EXPECT_EQ(cli_run("check " + refined + " --report " + plain.string()).exit_code, 0);
+  EXPECT_FALSE(read_json(plain).contains("worst_hexes"));
+  EXPECT_EQ(cli_run("check " + refined + " --worst 0").exit_code, 2);
+  EXPECT_EQ(cli_run("check " + refined + " --worst x").exit_code, 2);
+}
+
 TEST(CliCheck, BadInputAndUsage) {
   const auto dir = test_temp_dir("cli_check_bad");
   EXPECT_EQ(cli_run("check").exit_code, 2);

@@ -441,7 +441,9 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
   if (r.smoothing) {
     j["smoothing"] = {{"stats", *r.smoothing},
                       {"check", *r.smoothed_check},
-                      {"nodes_undone", r.smoothing_nodes_undone}};
+                      {"nodes_undone", r.smoothing_nodes_undone},
+                      {"max_sweeps", o.smoothing.max_sweeps},
+                      {"max_joint_iterations", o.smoothing.joint_iterations}};
     if (!r.smoothing_warning.empty()) j["smoothing"]["warning"] = r.smoothing_warning;
   }
   j["stage_seconds"] = r.stage_seconds;

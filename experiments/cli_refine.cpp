@@ -92,6 +92,17 @@ int refine_run(const CliArgs& a) {
     o.refine.placement.max_edge_ratio = cap;
     o.smoothing.max_edge_ratio = cap;
   }
+  // The smoothing's budget: fewer sweeps and joint iterations trade quality for time
+  // (results/smoothing_budget.md measures the trade on the real-mesh study).
+  for (const char* option : {"--smooth-sweeps", "--smooth-joint-iterations"})
+    if (a.value(option) && !o.smooth)
+      throw InputError(std::string("hexrefine refine: ") + option + " needs --smooth");
+  if (const auto n = a.value("--smooth-sweeps"))
+    o.smoothing.max_sweeps =
+        static_cast<int>(cli_parse_int_in(*n, 1, 1000000, "hexrefine refine: --smooth-sweeps"));
+  if (const auto n = a.value("--smooth-joint-iterations"))
+    o.smoothing.joint_iterations = static_cast<int>(
+        cli_parse_int_in(*n, 0, 1000000, "hexrefine refine: --smooth-joint-iterations"));
   if (const auto m = a.value("--max-hexes"))
     o.max_hexes = cli_parse_int_in(*m, 1, std::numeric_limits<int32_t>::max(), "--max-hexes");
   if (a.flag("--verbose")) o.verbose = &std::cerr;
@@ -165,6 +176,12 @@ const CliCommand cli_refine_command = {
          "smooth the refined region afterwards (checked again; starts from --placement untangle "
          "unless a placement is given; a smoothing the checker rejects is undone, with a warning "
          "in the report)"},
+        {"--smooth-sweeps", "N",
+         "--smooth: at most N sweeps over the region's nodes before the joint ascent and N after "
+         "it, 1..1000000 (default 20; fewer: faster, lower minimum)"},
+        {"--smooth-joint-iterations", "N",
+         "--smooth: at most N iterations of the joint ascent of the interior nodes around the "
+         "worst hexes, 0..1000000 (default 100; 0: the sweeps alone)"},
         {"--max-edge-ratio", "R",
          "optimized placement and --smooth give no hex an edge ratio above R or its ratio before "
          "(default 20; 0: no cap, the scaled Jacobian alone)"},

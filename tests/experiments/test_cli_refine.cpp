@@ -245,5 +245,48 @@ TEST(CliRefine, SmoothWithoutPlacementStartsFromUntangle) {
   }
 }
 
+TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
+  // Rockerarm refined around the sphere, one thread: the default budget (20 sweeps, 100
+  // joint iterations) ends at 0.4587; two sweeps and no joint ascent stop at 0.1973, still above
+  // the unsmoothed 0.0439, and the report names the budget used.
+  const auto dir = test_temp_dir("cli_refine_smoothing_budget");
+  const std::string out = (dir / "o.vtu").string(), report = (dir / "r.json").string();
+  const std::string base = join({"refine", shared_mesh("rockerarm.mesh"), out,
+                                 "--method selective --select sphere:0,0,0,5 --threads 1 --smooth "
+                                 "--report",
+                                 report});
+  struct Case {
+    std::string flags;
+    int sweeps, joint;
+    double smoothed;
+  };
+  for (const Case& c :
+       {Case{"", 20, 100, 0.45871972484485035},
+        Case{"--smooth-sweeps 2 --smooth-joint-iterations 0", 2, 0, 0.1972858580749072}}) {
+    SCOPED_TRACE(c.flags);
+    const CliRun r = cli_run(join({base, c.flags}));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json j = read_json(report);
+    const nlohmann::json& smoothing = j.at("smoothing");
+    EXPECT_EQ(smoothing.at("max_sweeps"), c.sweeps);
+    EXPECT_EQ(smoothing.at("max_joint_iterations"), c.joint);
+    EXPECT_LE(smoothing.at("stats").at("joint_iterations").get<int>(), c.joint);
+    EXPECT_NEAR(smoothing.at("check").at("min_scaled_jacobian").get<double>(), c.smoothed, 1e-9);
+    EXPECT_NEAR(j.at("check").at("min_scaled_jacobian").get<double>(), 0.0439162437334775, 1e-9);
+    EXPECT_TRUE(smoothing.at("check").at("valid").get<bool>());
+  }
+  // Two sweeps before the (skipped) joint ascent: no more than two carried out.
+  EXPECT_LE(read_json(report).at("smoothing").at("stats").at("sweeps").get<int>(), 2);
+  for (const std::string bad :
+       {"--smooth-sweeps 0", "--smooth-sweeps x", "--smooth-joint-iterations -1"})
+    EXPECT_EQ(cli_run(join({base, bad})).exit_code, 2) << bad;
+  const CliRun unsmoothed = cli_run(join({"refine", shared_mesh("rockerarm.mesh"), out,
+                                          "--method selective --select sphere:0,0,0,5 "
+                                          "--smooth-sweeps 2"}));
+  EXPECT_EQ(unsmoothed.exit_code, 2);
+  EXPECT_NE(unsmoothed.output.find("--smooth-sweeps needs --smooth"), std::string::npos)
+      << unsmoothed.output;
+}
+
 }  // namespace
 }  // namespace hexrefine

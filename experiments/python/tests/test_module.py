@@ -164,6 +164,15 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
     assert report["options"]["placement"]["method"] == "untangle"
     assert report["smoothing"]["check"]["min_scaled_jacobian"] == 0.45871972484485035
     assert report["smoothing"]["nodes_undone"] == 0 and "warning" not in report["smoothing"]
+    assert (report["smoothing"]["max_sweeps"], report["smoothing"]["max_joint_iterations"]) == \
+        (20, 100)
+    # A smaller budget: faster, lower (refine --smooth-sweeps 2 --smooth-joint-iterations 0).
+    _, budget = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=2,
+                                 smooth_joint_iterations=0)
+    assert budget["smoothing"]["check"]["min_scaled_jacobian"] == 0.1972858580749072
+    assert budget["smoothing"]["stats"]["joint_iterations"] == 0
+    with pytest.raises(ValueError, match="smooth_sweeps"):
+        hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=0)
 
 
 # --- errors --------------------------------------------------------------------------------------

@@ -22,14 +22,14 @@ public corpus is read from the folder it was given, /work/corpus here, not commi
 import argparse
 import datetime
 import json
-import os
 import pathlib
 import statistics
 import subprocess
 import sys
 import tempfile
 
-REPO = pathlib.Path(__file__).resolve().parent.parent
+from study_rerun import REPO, add_rerun_arguments, find_mesh, mesh_folders, smoothed_refine_argv
+
 MIN_INPUT_HEXES = 5000  # "rockerarm size": rockerarm has 10,600; real_meshes_report.py's bound
 EPS = 1e-12
 
@@ -43,30 +43,20 @@ def study_cases(records, folders):
             continue
         if r["input"]["hexes"] < MIN_INPUT_HEXES:
             continue
-        name = os.path.basename(r["input"]["file"])
-        path = next((pathlib.Path(f) / name for f in folders
-                     if (pathlib.Path(f) / name).exists()), None)
-        cases.append({"case": r["case"], "method": r["method"], "mesh": name,
-                      "path": str(path) if path else None, "specs": r["selection"]["specs"],
-                      "passes": r["options"]["passes"], "buffer": r["options"]["buffer"],
-                      "max_edge_ratio": r["options"]["placement"]["max_edge_ratio"]})
+        path = find_mesh(r, folders)
+        cases.append({"record": r, "path": str(path) if path else None,
+                      "mesh": pathlib.Path(r["input"]["file"]).name})
     return cases
 
 
 def run(hexrefine, case, sweeps, joint, tmp):
     out, report = pathlib.Path(tmp) / "out.vtu", pathlib.Path(tmp) / "r.json"
-    argv = [hexrefine, "refine", case["path"], str(out), "--method", case["method"]]
-    for spec in case["specs"]:
-        argv += ["--select", spec]
-    argv += ["--passes", str(case["passes"])]
-    if case["passes"] > 1:
-        argv += ["--buffer", case["buffer"]]
-    if case["max_edge_ratio"] != 20.0:
-        argv += ["--max-edge-ratio", repr(case["max_edge_ratio"])]
-    argv += ["--smooth", "--smooth-sweeps", str(sweeps), "--smooth-joint-iterations", str(joint),
-             "--threads", "1", "--report", str(report)]
+    r = case["record"]
+    argv = smoothed_refine_argv(hexrefine, case["path"], out, r) + [
+        "--smooth-sweeps", str(sweeps), "--smooth-joint-iterations", str(joint),
+        "--report", str(report)]
     p = subprocess.run(argv, capture_output=True, text=True)
-    row = {"case": case["case"], "method": case["method"], "mesh": case["mesh"],
+    row = {"case": r["case"], "method": r["method"], "mesh": case["mesh"],
            "sweeps": sweeps, "joint_iterations": joint}
     if p.returncode != 0:
         row["error"] = (p.stdout + p.stderr)[-500:]
@@ -132,30 +122,27 @@ def write_report(result, out_dir):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--records", default=str(REPO / "results" / "real_meshes.jsonl"))
-    ap.add_argument("--meshes", action="append", default=None)
-    ap.add_argument("--out", default=str(REPO / "results"))
+    add_rerun_arguments(ap)
     ap.add_argument("--budgets", nargs="+", default=["20,100", "6,30", "3,0", "1,0"])
-    ap.add_argument("--hexrefine", default=str(REPO / "build" / "experiments" / "hexrefine"))
-    ap.add_argument("--report-only", action="store_true")
     args = ap.parse_args()
     out_dir = pathlib.Path(args.out)
     if args.report_only:
         write_report(json.loads((out_dir / "smoothing_budget.json").read_text()), out_dir)
         return
-    folders = args.meshes or [str(REPO.parent / "shared" / "meshes")]
+    folders = mesh_folders(args)
     cases = study_cases([json.loads(line) for line in open(args.records)], folders)
     budgets = [tuple(int(x) for x in b.split(",")) for b in args.budgets]
     runs = []
     with tempfile.TemporaryDirectory() as tmp:
         for i, case in enumerate(cases):
             if case["path"] is None:
-                runs.append({"case": case["case"], "method": case["method"], "mesh": case["mesh"],
-                             "sweeps": 0, "joint_iterations": 0, "error": "mesh not found"})
+                runs.append({"case": case["record"]["case"], "method": case["record"]["method"],
+                             "mesh": case["mesh"], "sweeps": 0, "joint_iterations": 0,
+                             "error": "mesh not found"})
                 continue
             for sweeps, joint in budgets:
                 runs.append(run(args.hexrefine, case, sweeps, joint, tmp))
-            print(i, case["mesh"], case["case"], case["method"], file=sys.stderr, flush=True)
+            print(i, case["record"]["case"], case["record"]["method"], file=sys.stderr, flush=True)
     commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "HEAD"], capture_output=True,
                             text=True).stdout.strip()
     result = {"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),

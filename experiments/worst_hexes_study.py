@@ -27,13 +27,13 @@ import argparse
 import collections
 import datetime
 import json
-import os
 import pathlib
 import subprocess
 import sys
 import tempfile
 
-REPO = pathlib.Path(__file__).resolve().parent.parent
+from study_rerun import REPO, add_rerun_arguments, find_mesh, mesh_folders, smoothed_refine_argv
+
 EPS = 1e-12  # as real_meshes_report.py
 TEMPLATE_NAMES = {0: "untouched", 1: "1-27", 2: "1-13", 3: "1-5", 4: "1-4", 5: "1-3",
                   6: "1-3-adj1", 7: "1-3-adj2", 8: "directional", 9: "sheet", 10: "1-9"}
@@ -55,28 +55,6 @@ def failing_cases(records):
         if smoothed < 0.5 * parents["min_scaled_jacobian"] - EPS:
             out.append(r)
     return out
-
-
-def find_mesh(name, folders):
-    for folder in folders:
-        path = pathlib.Path(folder) / name
-        if path.exists():
-            return path
-    return None
-
-
-def refine_argv(hexrefine, mesh, out, r):
-    argv = [str(hexrefine), "refine", str(mesh), str(out), "--method", r["method"]]
-    for spec in r["selection"]["specs"]:
-        argv += ["--select", spec]
-    options = r["options"]
-    argv += ["--passes", str(options["passes"])]
-    if options["passes"] > 1:
-        argv += ["--buffer", options["buffer"]]
-    cap = options["placement"]["max_edge_ratio"]
-    if cap != 20.0:
-        argv += ["--max-edge-ratio", repr(cap)]
-    return argv + ["--smooth", "--threads", "1"]
 
 
 def band(count):
@@ -125,23 +103,19 @@ def tables(cases):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--records", default=str(REPO / "results" / "real_meshes.jsonl"))
-    ap.add_argument("--meshes", action="append", default=None)
-    ap.add_argument("--out", default=str(REPO / "results"))
-    ap.add_argument("--hexrefine", default=str(REPO / "build" / "experiments" / "hexrefine"))
-    ap.add_argument("--report-only", action="store_true")
+    add_rerun_arguments(ap)
     args = ap.parse_args()
     out_dir = pathlib.Path(args.out)
     if args.report_only:
         write_report(json.loads((out_dir / "worst_hexes.json").read_text()), out_dir)
         return
-    folders = args.meshes or [str(REPO.parent / "shared" / "meshes")]
+    folders = mesh_folders(args)
     records = [json.loads(line) for line in open(args.records)]
     cases = []
     with tempfile.TemporaryDirectory() as tmp:
         for i, r in enumerate(failing_cases(records)):
-            name = os.path.basename(r["input"]["file"])
-            mesh = find_mesh(name, folders)
+            name = pathlib.Path(r["input"]["file"]).name
+            mesh = find_mesh(r, folders)
             parents = r["refined_parents"]["min_scaled_jacobian"]
             recorded = r["smoothing"]["check"]["min_scaled_jacobian"]
             case = {"mesh": name, "kind": r["tags"]["kind"], "case": r["case"],
@@ -152,7 +126,7 @@ def main():
                 case["skipped"] = "mesh not found in " + ", ".join(folders)
                 continue
             out = pathlib.Path(tmp) / "out.vtu"
-            argv = refine_argv(args.hexrefine, mesh, out, r)
+            argv = smoothed_refine_argv(args.hexrefine, mesh, out, r)
             case["argv"] = ["hexrefine"] + argv[1:]
             refine = subprocess.run(argv, capture_output=True, text=True)
             if refine.returncode != 0:

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plots results/bench/history.jsonl (one record per `hexrefine bench --history` run): for each
 benchmark matching PATTERN (a regex; default: the refiners' and the command's largest sizes and
-the checker), the median CPU time of every run with its repetitions' range as an error bar, in
+the checker: the brick at 50^3, the refined 50^3 and 75^3 outputs on one and two threads), the median CPU time of every run with its repetitions' range as an error bar, in
 run order, labelled by date and commit. Writes results/bench/history.png.
 
 usage: plot_history.py [HISTORY.jsonl] [--pattern REGEX] [--out PNG]
@@ -23,7 +23,7 @@ parser.add_argument("history", nargs="?", default=os.path.join(here, "history.js
 parser.add_argument("--pattern",
                     default=r"bench_(full_brick|radial)/(selective|sheet)/50/|bench_command/"
                             r"exodus(_2_threads)?/50/|bench_check_brick(_2_threads)?/50/"
-                            r"|bench_real_mesh/")
+                            r"|bench_check_refined(_2_threads)?/(50|75)/|bench_real_mesh/")
 parser.add_argument("--out", default=os.path.join(here, "history.png"))
 args = parser.parse_args()
 

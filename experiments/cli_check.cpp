@@ -52,9 +52,13 @@ int check_run(const CliArgs& a) {
   if (a.positional.size() != 1)
     throw InputError(
         "hexrefine check: expected exactly one MESH argument (usage: hexrefine check "
-        "MESH [--reference REF] [--report R.json])");
+        "MESH [--reference REF] [--report R.json] [--sheets] [--worst K] [--threads N])");
   const std::string path = a.positional[0];
   const int threads = cli_threads(a.value("--threads"));
+  // Parsed before the mesh is read: a bad K fails at once, not after the check.
+  std::optional<int> worst_count;
+  if (const auto k = a.value("--worst"))
+    worst_count = static_cast<int>(cli_parse_int_in(*k, 1, 1000, "hexrefine check: --worst"));
   std::ostream* verbose = a.flag("--verbose") ? &std::cerr : nullptr;
   nlohmann::json stage_seconds = nlohmann::json::object();
   nlohmann::json stage_cpu_seconds = nlohmann::json::object();
@@ -99,18 +103,20 @@ int check_run(const CliArgs& a) {
     stage_end("sheets");
   }
   std::vector<WorstHex> worst;
-  if (const auto k = a.value("--worst")) {
-    worst =
-        mesh_worst_hexes(mesh, static_cast<int>(cli_parse_int_in(*k, 1, 1000, "--worst")), threads);
+  if (worst_count) {
+    worst = mesh_worst_hexes(mesh, *worst_count, threads);
     nlohmann::json list = nlohmann::json::array();
     for (const WorstHex& w : worst) {
       nlohmann::json attributes = nlohmann::json::object();
       for (const HexAttribute& attribute : mesh.attributes)
         attributes[attribute.name] = attribute.values[w.hex];
-      list.push_back({{"hex", w.hex},
-                      {"scaled_jacobian", w.scaled_jacobian},
-                      {"boundary_faces", w.boundary_faces},
-                      {"attributes", attributes}});
+      nlohmann::json entry = {{"hex", w.hex},
+                              {"scaled_jacobian", w.scaled_jacobian},
+                              {"boundary_faces", w.boundary_faces},
+                              {"attributes", attributes}};
+      if (const std::vector<int32_t>* tag = mesh_find_attribute(mesh, attribute_template_tag))
+        entry["template"] = template_tag_name(static_cast<TemplateTag>((*tag)[w.hex]));
+      list.push_back(entry);
     }
     json["worst_hexes"] = list;
     stage_end("worst");

@@ -80,13 +80,16 @@ def tables(cases):
                  "faces (%.1f %%); %d of %d cases have none among their ten worst." % (
                      len(every), two, 100.0 * two / max(1, len(every)), none, len(ran)))
     lines.append("")
-    lines.append("| the worst hex came from | cases |")
+    lines.append("| the worst hex's template tag | cases |")
     lines.append("|---|---:|")
     origin = collections.Counter(c["worst"][0]["template"] for c in ran)
     for name, count in origin.most_common():
         lines.append("| %s | %d |" % (name, count))
     lines.append("")
-    lines.append("*untouched*: an input hex the refinement did not touch, whose own scaled "
+    lines.append("Every tag but *untouched* is a child of a refined hex: 1-13, 1-5, 1-4 and "
+                 "directional children are the Selective Approach's transitions; *sheet* tags "
+                 "every child of the sheet refiner's region, transition or not. "
+                 "*untouched*: an input hex the refinement did not touch, whose own scaled "
                  "Jacobian is below half the refined parents' minimum (the target's whole-mesh "
                  "figure counts it; its children-only row in real_meshes.md does not).")
     lines.append("")
@@ -127,7 +130,7 @@ def main():
                 continue
             out = pathlib.Path(tmp) / "out.vtu"
             argv = smoothed_refine_argv(args.hexrefine, mesh, out, r)
-            case["argv"] = ["hexrefine"] + argv[1:]
+            case["argv"] = ["hexrefine", "refine", name, "OUT.vtu"] + argv[4:]
             refine = subprocess.run(argv, capture_output=True, text=True)
             if refine.returncode != 0:
                 case["error"] = refine.stdout[-500:] + refine.stderr[-500:]
@@ -143,8 +146,8 @@ def main():
             case["rerun_min"] = j["min_scaled_jacobian"]
             case["worst"] = [{"hex": w["hex"], "scaled_jacobian": w["scaled_jacobian"],
                               "boundary_faces": w["boundary_faces"],
-                              "template": TEMPLATE_NAMES.get(
-                                  w["attributes"].get("template_tag", -1), "?"),
+                              "template": w.get("template", TEMPLATE_NAMES.get(
+                                  w["attributes"].get("template_tag", -1), "?")),
                               "parent_hex": w["attributes"].get("parent_hex")}
                              for w in j["worst_hexes"]]
             print("%d %s %s %s: %.3f, worst hex %d boundary faces, %s" % (
@@ -176,7 +179,8 @@ def write_report(result, out_dir):
               len(reproduced) - len(mismatches), len(reproduced)),
           "",
           "Reruns whose minimum differs from the record (the code changed since the study's "
-          "commit; the tables use the rerun): " + (", ".join(
+          "commit; the boundary-face and template tables use the rerun, the last table the "
+          "recorded ratio): " + (", ".join(
               "%s %s %s %.4g -> %.4g" % (c["mesh"], c["kind"], c["method"], c["recorded_min"],
                                          c["rerun_min"]) for c in mismatches) or "none") + ".",
           "",

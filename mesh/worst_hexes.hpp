@@ -15,7 +15,7 @@
 namespace hexrefine {
 
 struct WorstHex {
-  int32_t hex = -1;
+  int32_t hex = -1;  ///< its id, in [0, hex_count)
   /// hex_scaled_jacobian of the hex, in [-1, 1].
   double scaled_jacobian = 1.0;
   /// How many of its six faces no other hex uses, in [0, 6].

@@ -235,8 +235,8 @@ PYBIND11_MODULE(_hexrefine, m) {
       [](const HexMesh& mesh, const py::object& targets, const std::string& method, int passes,
          const std::string& buffer, bool smooth, bool ranking, const std::string& directional_order,
          bool propagation, bool ebe_only, const std::string& placement, int threads,
-         bool allow_inverted, int64_t max_hexes, double max_edge_ratio, int smooth_sweeps,
-         int smooth_joint_iterations) {
+         bool allow_inverted, int64_t max_hexes, double max_edge_ratio,
+         std::optional<int> smooth_sweeps, std::optional<int> smooth_joint_iterations) {
         PipelineOptions o;
         o.method = method;
         if (py::isinstance<py::str>(targets) || py::isinstance<py::list>(targets) ||
@@ -299,14 +299,20 @@ PYBIND11_MODULE(_hexrefine, m) {
                            std::to_string(max_edge_ratio));
         o.refine.placement.max_edge_ratio = max_edge_ratio;
         o.smoothing.max_edge_ratio = max_edge_ratio;
-        if (smooth_sweeps < 1 || smooth_sweeps > 1000000)
+        // As the CLI: a budget without smoothing is refused, not ignored.
+        if ((smooth_sweeps || smooth_joint_iterations) && !smooth)
+          throw InputError(
+              std::string(smooth_sweeps ? "smooth_sweeps" : "smooth_joint_iterations") +
+              " needs smooth=True");
+        if (smooth_sweeps && (*smooth_sweeps < 1 || *smooth_sweeps > 1000000))
           throw InputError("smooth_sweeps must be in 1..1000000, got " +
-                           std::to_string(smooth_sweeps));
-        if (smooth_joint_iterations < 0 || smooth_joint_iterations > 1000000)
+                           std::to_string(*smooth_sweeps));
+        if (smooth_joint_iterations &&
+            (*smooth_joint_iterations < 0 || *smooth_joint_iterations > 1000000))
           throw InputError("smooth_joint_iterations must be in 0..1000000, got " +
-                           std::to_string(smooth_joint_iterations));
-        o.smoothing.max_sweeps = smooth_sweeps;
-        o.smoothing.joint_iterations = smooth_joint_iterations;
+                           std::to_string(*smooth_joint_iterations));
+        if (smooth_sweeps) o.smoothing.max_sweeps = *smooth_sweeps;
+        if (smooth_joint_iterations) o.smoothing.joint_iterations = *smooth_joint_iterations;
         o.max_hexes = max_hexes;
         PipelineResult r;
         {
@@ -319,8 +325,7 @@ PYBIND11_MODULE(_hexrefine, m) {
       "smooth"_a = false, "ranking"_a = true, "directional_order"_a = "by_hex",
       "propagation"_a = true, "ebe_only"_a = false, "placement"_a = "", "threads"_a = 1,
       "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647}, "max_edge_ratio"_a = 20.0,
-      "smooth_sweeps"_a = pipeline_smoothing_defaults().max_sweeps,
-      "smooth_joint_iterations"_a = pipeline_smoothing_defaults().joint_iterations,
+      "smooth_sweeps"_a = py::none(), "smooth_joint_iterations"_a = py::none(),
       "Refines `targets` (hex ids, or selection specs) by `method` through the pipeline: plan, "
       "apply, place the new nodes (placement 'optimized', the thesis' 'trilinear', 'reference': "
       "the templates' reference positions, or 'untangle': trilinear with inverted children "
@@ -332,8 +337,9 @@ PYBIND11_MODULE(_hexrefine, m) {
       "'transitions' or 'none'. `threads`: for the template application, node placement, "
       "smoothing and the check (the same mesh for any count). `max_edge_ratio`: optimized "
       "placement and smoothing give no hex an edge ratio above it or its ratio before (0: no "
-      "cap). `smooth_sweeps`, `smooth_joint_iterations`: the smoothing's budget (refine "
-      "--smooth-sweeps, --smooth-joint-iterations). RefinementError if the method "
+      "cap). `smooth_sweeps`, `smooth_joint_iterations` (smooth=True only; None: 20 and 100): "
+      "the smoothing's budget (refine --smooth-sweeps, --smooth-joint-iterations). "
+      "RefinementError if the method "
       "refuses or the result "
       "is invalid (unless an ablation switch or allow_inverted); ValueError for bad input.");
   m.def(

@@ -224,6 +224,7 @@ TEST(CliCheck, WorstHexesNameTheirPlaceTemplateAndParent) {
     EXPECT_LE(w["boundary_faces"].get<int>(), 3);
     EXPECT_GE(w["attributes"]["refinement_level"].get<int>(), 1);  // a child, not an input hex
     EXPECT_GT(w["attributes"]["template_tag"].get<int>(), 0);
+    EXPECT_NE(w["template"], "untouched");
     EXPECT_NE(
         run.output.find("worst: hex " + std::to_string(w["hex"].get<int>()) + ", scaled Jacobian"),
         std::string::npos)

@@ -274,9 +274,11 @@ TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
     EXPECT_NEAR(smoothing.at("check").at("min_scaled_jacobian").get<double>(), c.smoothed, 1e-9);
     EXPECT_NEAR(j.at("check").at("min_scaled_jacobian").get<double>(), 0.0439162437334775, 1e-9);
     EXPECT_TRUE(smoothing.at("check").at("valid").get<bool>());
+    // With the joint ascent skipped, only the first round of sweeps runs.
+    if (c.joint == 0) {
+      EXPECT_LE(smoothing.at("stats").at("sweeps").get<int>(), c.sweeps);
+    }
   }
-  // Two sweeps before the (skipped) joint ascent: no more than two carried out.
-  EXPECT_LE(read_json(report).at("smoothing").at("stats").at("sweeps").get<int>(), 2);
   for (const std::string bad :
        {"--smooth-sweeps 0", "--smooth-sweeps x", "--smooth-joint-iterations -1"})
     EXPECT_EQ(cli_run(join({base, bad})).exit_code, 2) << bad;

@@ -34,6 +34,17 @@ TEST(WorstHexes, BoundaryFacesOfA3x3x3BrickByPlace) {
   EXPECT_TRUE(mesh_worst_hexes(m, 0).empty());
 }
 
+TEST(WorstHexes, TiesAcrossChunksGoByIdForEveryThreadCount) {
+  // 30^3 unit cubes: 27,000 equal values over two of its chunks (16,384 hexes each), each
+  // trimmed: the lowest 20,000 by (value, id) are ids 0 .. 19,999 on any thread count.
+  const HexMesh m = fixture_brick(30, 30, 30);
+  for (const int threads : {1, 2}) {
+    const std::vector<WorstHex> worst = mesh_worst_hexes(m, 20000, threads);
+    ASSERT_EQ(worst.size(), 20000u);
+    for (size_t k = 0; k < worst.size(); ++k) ASSERT_EQ(worst[k].hex, static_cast<int32_t>(k));
+  }
+}
+
 TEST(WorstHexes, TheLowestByValueForEveryThreadCount) {
   // 40^3 jittered: several of mesh_worst_hexes' chunks, each trimmed more than once.
   BrickParams p;

@@ -173,6 +173,8 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
     assert budget["smoothing"]["stats"]["joint_iterations"] == 0
     with pytest.raises(ValueError, match="smooth_sweeps"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=0)
+    with pytest.raises(ValueError, match="smooth_joint_iterations needs smooth=True"):
+        hexrefine.refine(mesh, "sphere:0,0,0,5", smooth_joint_iterations=5)
 
 
 # --- errors --------------------------------------------------------------------------------------

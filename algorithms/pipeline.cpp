@@ -443,7 +443,8 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
                       {"check", *r.smoothed_check},
                       {"nodes_undone", r.smoothing_nodes_undone},
                       {"max_sweeps", o.smoothing.max_sweeps},
-                      {"max_joint_iterations", o.smoothing.joint_iterations}};
+                      {"max_joint_iterations", o.smoothing.joint_iterations},
+                      {"max_joint_rounds", o.smoothing.joint_rounds}};
     if (!r.smoothing_warning.empty()) j["smoothing"]["warning"] = r.smoothing_warning;
   }
   j["stage_seconds"] = r.stage_seconds;

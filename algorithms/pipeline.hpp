@@ -147,10 +147,10 @@ inline constexpr int pipeline_report_schema_version = 1;
 /// "hexes", "warning"?}), "refine" (RefineStats), "refined_parents" ({"hexes",
 /// "min_scaled_jacobian", "children_min_scaled_jacobian",
 /// "smoothed_children_min_scaled_jacobian"?}), "check", "smoothing"? ({"stats", "check",
-/// "nodes_undone", "max_sweeps", "max_joint_iterations", "warning"?}: the last two are the
-/// smoothing's budget, options.smoothing's), "stage_seconds", "stage_cpu_seconds",
-/// "peak_memory_mb". The CLI writes it with --report, the runner adds its identification fields to
-/// it, the Python module returns it as a dict.
+/// "nodes_undone", "max_sweeps", "max_joint_iterations", "max_joint_rounds", "warning"?}: the
+/// three max_ are the smoothing's budget, options.smoothing's), "stage_seconds",
+/// "stage_cpu_seconds", "peak_memory_mb". The CLI writes it with --report, the runner adds its
+/// identification fields to it, the Python module returns it as a dict.
 nlohmann::json pipeline_report(const PipelineResult& result, const PipelineOptions& options);
 
 /// Peak resident set size of this process in MB (getrusage), 0 if unknown.

@@ -94,7 +94,8 @@ int refine_run(const CliArgs& a) {
   }
   // The smoothing's budget: fewer sweeps and joint iterations trade quality for time
   // (results/smoothing_budget.md measures the trade on the real-mesh study).
-  for (const char* option : {"--smooth-sweeps", "--smooth-joint-iterations"})
+  for (const char* option :
+       {"--smooth-sweeps", "--smooth-joint-iterations", "--smooth-joint-rounds"})
     if (a.value(option) && !o.smooth)
       throw InputError(std::string("hexrefine refine: ") + option + " needs --smooth");
   if (const auto n = a.value("--smooth-sweeps"))
@@ -103,6 +104,9 @@ int refine_run(const CliArgs& a) {
   if (const auto n = a.value("--smooth-joint-iterations"))
     o.smoothing.joint_iterations = static_cast<int>(
         cli_parse_int_in(*n, 0, 1000000, "hexrefine refine: --smooth-joint-iterations"));
+  if (const auto n = a.value("--smooth-joint-rounds"))
+    o.smoothing.joint_rounds =
+        static_cast<int>(cli_parse_int_in(*n, 1, 1000, "hexrefine refine: --smooth-joint-rounds"));
   if (const auto m = a.value("--max-hexes"))
     o.max_hexes = cli_parse_int_in(*m, 1, std::numeric_limits<int32_t>::max(), "--max-hexes");
   if (a.flag("--verbose")) o.verbose = &std::cerr;
@@ -178,10 +182,14 @@ const CliCommand cli_refine_command = {
          "in the report)"},
         {"--smooth-sweeps", "N",
          "--smooth: at most N sweeps over the region's nodes before the joint ascent and N after "
-         "it, 1..1000000 (default 20; fewer: faster, lower minimum)"},
+         "each of its rounds, 1..1000000 (default 20; fewer: faster, lower minimum)"},
         {"--smooth-joint-iterations", "N",
-         "--smooth: at most N iterations of the joint ascent of the interior nodes around the "
-         "worst hexes, 0..1000000 (default 100; 0: the sweeps alone)"},
+         "--smooth: at most N iterations per round of the joint ascent of the nodes around the "
+         "worst hexes (boundary nodes on the surface), 0..1000000 (default 100; 0: the sweeps "
+         "alone)"},
+        {"--smooth-joint-rounds", "N",
+         "--smooth: at most N rounds of joint ascent and sweeps, each with a sharper soft "
+         "minimum, while a round raises the minimum, 1..1000 (default 3)"},
         {"--max-edge-ratio", "R",
          "optimized placement and --smooth give no hex an edge ratio above R or its ratio before "
          "(default 20; 0: no cap, the scaled Jacobian alone)"},

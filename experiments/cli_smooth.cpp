@@ -1,6 +1,6 @@
 /// \file
 /// `hexrefine smooth IN OUT [--method laplacian|optimize] [--region SPEC ...] [--sweeps N]
-/// [--joint-iterations N]
+/// [--joint-iterations N] [--joint-rounds N]
 /// [--report R.json]`: reads IN, smooths it (algorithms/placement/smoothing.hpp), writes OUT
 /// (formats by extension, mesh/io.hpp) and optionally a JSON report with the minimum and mean
 /// scaled Jacobian before and after, seconds, sweeps and nodes moved.
@@ -57,6 +57,9 @@ int smooth_run(const CliArgs& a) {
       throw InputError("hexrefine smooth: --joint-iterations must be in 0..1000000, got " + *joint);
     options.joint_iterations = static_cast<int>(n);
   }
+  if (const auto rounds = a.value("--joint-rounds"))
+    options.joint_rounds =
+        static_cast<int>(cli_parse_int_in(*rounds, 1, 1000, "hexrefine smooth: --joint-rounds"));
   if (const auto r = a.value("--max-edge-ratio")) {
     const double cap = cli_parse_double(*r, "hexrefine smooth: --max-edge-ratio");
     if (!(cap == 0 || (cap >= 1 && cap <= 1e6)))
@@ -97,6 +100,7 @@ int smooth_run(const CliArgs& a) {
     report["method"] = smooth_method_name(options.method);
     report["max_sweeps"] = options.max_sweeps;
     report["max_joint_iterations"] = options.joint_iterations;
+    report["max_joint_rounds"] = options.joint_rounds;
     report["max_edge_ratio"] = options.max_edge_ratio;
     report["hexes"] = mesh.hex_count();
     report["nodes"] = mesh.point_count();
@@ -120,10 +124,14 @@ const CliCommand cli_smooth_command = {
         {"--region", "SPEC", "move only the nodes of these hexes (selection specs, united)", true},
         {"--sweeps", "N",
          "at most N sweeps, 0..1000000 (default 20; optimize: N before the joint ascent and N "
-         "after it)"},
+         "after each round of it)"},
         {"--joint-iterations", "N",
-         "optimize: at most N iterations of the joint ascent of the interior nodes around the "
-         "worst hexes after the sweeps, 0..1000000 (default 100; 0: the sweeps alone)"},
+         "optimize: at most N iterations per round of the joint ascent of the nodes around the "
+         "worst hexes after the sweeps (boundary nodes on the surface), 0..1000000 (default 100; "
+         "0: the sweeps alone)"},
+        {"--joint-rounds", "N",
+         "optimize: at most N rounds of joint ascent and sweeps while a round raises the "
+         "minimum, 1..1000 (default 3)"},
         {"--max-edge-ratio", "R",
          "give no hex an edge ratio above R or its ratio before (default 20; 0: no cap, the "
          "scaled Jacobian alone)"},

@@ -30,10 +30,11 @@
 ///     improves neither the minimum nor the mean.
 ///  4. (optimize) Where the sweeps stop, the worst hexes are usually held by several nodes at
 ///     once (a transition child whose corners all sit at the minimum, a flat boundary layer that
-///     must thicken as a whole): a joint ascent moves the interior nodes around them together
-///     (node_joint_ascent.hpp), and if it raised the minimum the sweeps run again from there.
-///     On the shared sphere mesh's 1-13 children of flat boundary parents it takes the smoothed
-///     minimum from 0.384 (sweeps alone) to about 0.54.
+///     must thicken as a whole): a joint ascent moves the nodes around them together, boundary
+///     nodes on their slides, steered along the edge-ratio caps (node_joint_ascent.hpp), and if
+///     it raised the minimum the sweeps run again from there; up to joint_rounds rounds, each
+///     with a sharper soft minimum. On the shared sphere mesh's 1-13 children of flat boundary
+///     parents it takes the smoothed minimum from 0.384 (sweeps alone) to about 0.54.
 
 #include "algorithms/placement/smoothing.hpp"
 
@@ -175,6 +176,9 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
   if (options.joint_iterations < 0)
     throw InputError("mesh_smooth: joint_iterations must be >= 0, got " +
                      std::to_string(options.joint_iterations));
+  if (options.joint_rounds < 1)
+    throw InputError("mesh_smooth: joint_rounds must be >= 1, got " +
+                     std::to_string(options.joint_rounds));
   if (!(options.feature_angle_degrees > 0 && options.feature_angle_degrees < 180))
     throw InputError("mesh_smooth: feature angle must be in (0, 180) degrees, got " +
                      std::to_string(options.feature_angle_degrees));
@@ -379,9 +383,13 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
   joint_options.max_iterations =
       options.method == SmoothMethod::optimize ? options.joint_iterations : 0;
   joint_options.threads = options.threads;
+  joint_options.slide = true;
+  joint_options.cap_samples = true;
+  joint_options.rounds = options.joint_rounds;
   const SweepsAndAscentStats run = nodes_sweep_and_ascend(mesh, problem, o, joint_options);
   stats.sweeps = run.sweeps;
   stats.joint_iterations = run.joint_iterations;
+  stats.joint_rounds = run.joint_rounds;
   stats.nodes_moved = 0;
   for (size_t i = 0; i < problem.nodes.size(); ++i)
     stats.nodes_moved += mesh.points[problem.nodes[i]] != start_points[i];

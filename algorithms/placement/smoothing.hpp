@@ -26,8 +26,9 @@ namespace hexrefine {
 enum class SmoothMethod {
   laplacian,  ///< guarded Laplacian: towards the mean of the edge neighbours
   optimize,   ///< guarded Laplacian candidate, then a mean-ratio Newton step, then ascent of the
-              ///< minimum scaled Jacobian of the hexes around the node; then a joint ascent of
-              ///< the interior nodes around the worst hexes and the sweeps again
+              ///< minimum scaled Jacobian of the hexes around the node; then rounds of joint
+              ///< ascent of the nodes around the worst hexes (boundary nodes on their slides)
+              ///< and the sweeps again
 };
 
 /// How smoothing treats a boundary node, from the boundary faces around it.
@@ -52,7 +53,8 @@ SmoothNodeClasses mesh_classify_smooth_nodes(const HexMesh& mesh, const HexTopol
 
 struct SmoothOptions {
   SmoothMethod method = SmoothMethod::optimize;
-  int max_sweeps = 20;  ///< >= 0, before the joint ascent and again after it; 0 only measures
+  /// >= 0, before the joint ascent and again after each of its rounds; 0 only measures.
+  int max_sweeps = 20;
   /// Boundary faces whose normals differ by more than this (in (0, 180)) meet at a feature edge.
   double feature_angle_degrees = 30;
   /// Empty: all hexes. Otherwise only the nodes of these hexes move (ids in [0, hex_count)).
@@ -71,10 +73,15 @@ struct SmoothOptions {
   const BoundaryReference* reference = nullptr;
   int32_t reference_nodes = 0;
   int threads = 1;  ///< >= 1: threads for the node visits (the result is the same for any count)
-  /// optimize, >= 0: L-BFGS iterations of the joint ascent of the interior nodes around the
-  /// worst hexes after the sweeps (node_joint_ascent.hpp; 0: none), then the sweeps again if it
-  /// raised the minimum. Not with max_sweeps 0 (which only measures).
+  /// optimize, >= 0: L-BFGS iterations per round of the joint ascent of the nodes around the
+  /// worst hexes after the sweeps, interior nodes and boundary nodes on their slides
+  /// (node_joint_ascent.hpp; 0: none), then the sweeps again if it raised the minimum. Not with
+  /// max_sweeps 0 (which only measures).
   int joint_iterations = 100;
+  /// >= 1: rounds of joint ascent and sweeps, while a round raises the minimum
+  /// (JointAscentOptions::rounds; results/smoothing_budget.md compares one round and three on
+  /// the real-mesh study's cases of rocker arm size).
+  int joint_rounds = 3;
   /// No move gives a hex an edge ratio above max(max_edge_ratio, its ratio before smoothing)
   /// (NodeOptimizerOptions::max_edge_ratio; <= 0: no cap, the scaled Jacobian alone).
   double max_edge_ratio = 20;
@@ -89,17 +96,18 @@ struct SmoothStats {
   int64_t nodes_moved = 0;   ///< nodes whose final position differs from the input
   int64_t region_hexes = 0;  ///< hexes of the region and its layers
   int64_t movable_nodes = 0;
-  int joint_iterations = 0;  ///< iterations of the joint ascent carried out
+  int joint_iterations = 0;  ///< iterations of the joint ascent carried out, every round
+  int joint_rounds = 0;      ///< rounds of joint ascent that raised the minimum
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SmoothStats, min_scaled_jacobian_before,
                                                 min_scaled_jacobian_after,
                                                 mean_scaled_jacobian_before,
                                                 mean_scaled_jacobian_after, seconds, sweeps,
                                                 nodes_moved, region_hexes, movable_nodes,
-                                                joint_iterations)
+                                                joint_iterations, joint_rounds)
 
 /// Smooths `mesh` in place. Throws InputError for bad options (negative sweeps, layers or joint
-/// iterations, feature
+/// iterations, joint rounds below 1, feature
 /// angle outside (0, 180), visit_below outside (0, 1], region hex id out of range) or a mesh
 /// failing mesh_validate_ids or holding a non-finite coordinate. The min and mean before and after
 /// are over the whole mesh.

@@ -236,7 +236,8 @@ PYBIND11_MODULE(_hexrefine, m) {
          const std::string& buffer, bool smooth, bool ranking, const std::string& directional_order,
          bool propagation, bool ebe_only, const std::string& placement, int threads,
          bool allow_inverted, int64_t max_hexes, double max_edge_ratio,
-         std::optional<int> smooth_sweeps, std::optional<int> smooth_joint_iterations) {
+         std::optional<int> smooth_sweeps, std::optional<int> smooth_joint_iterations,
+         std::optional<int> smooth_joint_rounds) {
         PipelineOptions o;
         o.method = method;
         if (py::isinstance<py::str>(targets) || py::isinstance<py::list>(targets) ||
@@ -300,10 +301,11 @@ PYBIND11_MODULE(_hexrefine, m) {
         o.refine.placement.max_edge_ratio = max_edge_ratio;
         o.smoothing.max_edge_ratio = max_edge_ratio;
         // As the CLI: a budget without smoothing is refused, not ignored.
-        if ((smooth_sweeps || smooth_joint_iterations) && !smooth)
-          throw InputError(
-              std::string(smooth_sweeps ? "smooth_sweeps" : "smooth_joint_iterations") +
-              " needs smooth=True");
+        if ((smooth_sweeps || smooth_joint_iterations || smooth_joint_rounds) && !smooth)
+          throw InputError(std::string(smooth_sweeps             ? "smooth_sweeps"
+                                       : smooth_joint_iterations ? "smooth_joint_iterations"
+                                                                 : "smooth_joint_rounds") +
+                           " needs smooth=True");
         if (smooth_sweeps && (*smooth_sweeps < 1 || *smooth_sweeps > 1000000))
           throw InputError("smooth_sweeps must be in 1..1000000, got " +
                            std::to_string(*smooth_sweeps));
@@ -311,7 +313,11 @@ PYBIND11_MODULE(_hexrefine, m) {
             (*smooth_joint_iterations < 0 || *smooth_joint_iterations > 1000000))
           throw InputError("smooth_joint_iterations must be in 0..1000000, got " +
                            std::to_string(*smooth_joint_iterations));
+        if (smooth_joint_rounds && (*smooth_joint_rounds < 1 || *smooth_joint_rounds > 1000))
+          throw InputError("smooth_joint_rounds must be in 1..1000, got " +
+                           std::to_string(*smooth_joint_rounds));
         if (smooth_sweeps) o.smoothing.max_sweeps = *smooth_sweeps;
+        if (smooth_joint_rounds) o.smoothing.joint_rounds = *smooth_joint_rounds;
         if (smooth_joint_iterations) o.smoothing.joint_iterations = *smooth_joint_iterations;
         o.max_hexes = max_hexes;
         PipelineResult r;
@@ -326,6 +332,7 @@ PYBIND11_MODULE(_hexrefine, m) {
       "propagation"_a = true, "ebe_only"_a = false, "placement"_a = "", "threads"_a = 1,
       "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647}, "max_edge_ratio"_a = 20.0,
       "smooth_sweeps"_a = py::none(), "smooth_joint_iterations"_a = py::none(),
+      "smooth_joint_rounds"_a = py::none(),
       "Refines `targets` (hex ids, or selection specs) by `method` through the pipeline: plan, "
       "apply, place the new nodes (placement 'optimized', the thesis' 'trilinear', 'reference': "
       "the templates' reference positions, or 'untangle': trilinear with inverted children "
@@ -337,8 +344,9 @@ PYBIND11_MODULE(_hexrefine, m) {
       "'transitions' or 'none'. `threads`: for the template application, node placement, "
       "smoothing and the check (the same mesh for any count). `max_edge_ratio`: optimized "
       "placement and smoothing give no hex an edge ratio above it or its ratio before (0: no "
-      "cap). `smooth_sweeps`, `smooth_joint_iterations` (smooth=True only; None: 20 and 100): "
-      "the smoothing's budget (refine --smooth-sweeps, --smooth-joint-iterations). "
+      "cap). `smooth_sweeps`, `smooth_joint_iterations`, `smooth_joint_rounds` (smooth=True "
+      "only; None: 20, 100 and 3): the smoothing's budget (refine --smooth-sweeps, "
+      "--smooth-joint-iterations, --smooth-joint-rounds). "
       "RefinementError if the method "
       "refuses or the result "
       "is invalid (unless an ablation switch or allow_inverted); ValueError for bad input.");

@@ -247,8 +247,9 @@ TEST(CliRefine, SmoothWithoutPlacementStartsFromUntangle) {
 
 TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
   // Rockerarm refined around the sphere, one thread: the default budget (20 sweeps, 100
-  // joint iterations) ends at 0.4587; two sweeps and no joint ascent stop at 0.1973, still above
-  // the unsmoothed 0.0439, and the report names the budget used.
+  // joint iterations, 3 rounds) ends at 0.5249, one round at 0.4894; two sweeps and no joint
+  // ascent stop at 0.1973, still above the unsmoothed 0.0439, and the report names the budget
+  // used.
   const auto dir = test_temp_dir("cli_refine_smoothing_budget");
   const std::string out = (dir / "o.vtu").string(), report = (dir / "r.json").string();
   const std::string base = join({"refine", shared_mesh("rockerarm.mesh"), out,
@@ -257,12 +258,13 @@ TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
                                  report});
   struct Case {
     std::string flags;
-    int sweeps, joint;
+    int sweeps, joint, rounds;
     double smoothed;
   };
   for (const Case& c :
-       {Case{"", 20, 100, 0.45871972484485035},
-        Case{"--smooth-sweeps 2 --smooth-joint-iterations 0", 2, 0, 0.1972858580749072}}) {
+       {Case{"", 20, 100, 3, 0.5248719182924853},
+        Case{"--smooth-joint-rounds 1", 20, 100, 1, 0.4893584069476542},
+        Case{"--smooth-sweeps 2 --smooth-joint-iterations 0", 2, 0, 3, 0.1972858580749072}}) {
     SCOPED_TRACE(c.flags);
     const CliRun r = cli_run(join({base, c.flags}));
     ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -270,7 +272,10 @@ TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
     const nlohmann::json& smoothing = j.at("smoothing");
     EXPECT_EQ(smoothing.at("max_sweeps"), c.sweeps);
     EXPECT_EQ(smoothing.at("max_joint_iterations"), c.joint);
-    EXPECT_LE(smoothing.at("stats").at("joint_iterations").get<int>(), c.joint);
+    EXPECT_EQ(smoothing.at("max_joint_rounds"), c.rounds);
+    // Every round raised the minimum here (none without the joint ascent).
+    EXPECT_EQ(smoothing.at("stats").at("joint_rounds").get<int>(), c.joint == 0 ? 0 : c.rounds);
+    EXPECT_LE(smoothing.at("stats").at("joint_iterations").get<int>(), c.joint * c.rounds);
     EXPECT_NEAR(smoothing.at("check").at("min_scaled_jacobian").get<double>(), c.smoothed, 1e-9);
     EXPECT_NEAR(j.at("check").at("min_scaled_jacobian").get<double>(), 0.0439162437334775, 1e-9);
     EXPECT_TRUE(smoothing.at("check").at("valid").get<bool>());
@@ -280,7 +285,8 @@ TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
     }
   }
   for (const std::string bad :
-       {"--smooth-sweeps 0", "--smooth-sweeps x", "--smooth-joint-iterations -1"})
+       {"--smooth-sweeps 0", "--smooth-sweeps x", "--smooth-joint-iterations -1",
+        "--smooth-joint-rounds 0", "--smooth-joint-rounds 1001"})
     EXPECT_EQ(cli_run(join({base, bad})).exit_code, 2) << bad;
   const CliRun unsmoothed = cli_run(join({"refine", shared_mesh("rockerarm.mesh"), out,
                                           "--method selective --select sphere:0,0,0,5 "

@@ -146,12 +146,13 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
                                        placement="optimized")
     np.testing.assert_array_equal(one.points, two.points)  # bit for bit
     # The serial values (rockerarm issue-sphere, selective: reference positions, the worst
-    # children optimised; smoothed: sweeps, joint ascent, sweeps), no hex stretched past the
-    # default edge-ratio cap of 20.
+    # children optimised, one stretched to the default edge-ratio cap of 20; smoothed: sweeps,
+    # then three rounds of joint ascent and sweeps, steered along the cap), no hex stretched
+    # past the cap.
     assert report_one["check"]["min_scaled_jacobian"] == 0.11023223760640442
-    assert report_two["smoothing"]["check"]["min_scaled_jacobian"] == 0.4051133683514108
-    for report in (report_one["check"], report_two["smoothing"]["check"]):
-        assert 19.9 < report["max_edge_ratio"] <= 20 * (1 + 1e-9)
+    assert report_two["smoothing"]["check"]["min_scaled_jacobian"] == 0.5187300017566453
+    assert 19.9 < report_one["check"]["max_edge_ratio"] <= 20 * (1 + 1e-9)
+    assert 19 < report_two["smoothing"]["check"]["max_edge_ratio"] <= 20 * (1 + 1e-9)
     # Without the cap, the scaled Jacobian alone: higher minima by collapsed edges.
     _, uncapped = hexrefine.refine(mesh, "sphere:0,0,0,5", max_edge_ratio=0)
     assert uncapped["check"]["min_scaled_jacobian"] == 0.11783137589340247
@@ -162,10 +163,13 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
     # positions with the inverted children untangled, then smoothing, higher than from optimized.
     _, report = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True)
     assert report["options"]["placement"]["method"] == "untangle"
-    assert report["smoothing"]["check"]["min_scaled_jacobian"] == 0.45871972484485035
+    assert report["smoothing"]["check"]["min_scaled_jacobian"] == 0.5248719182924853
     assert report["smoothing"]["nodes_undone"] == 0 and "warning" not in report["smoothing"]
-    assert (report["smoothing"]["max_sweeps"], report["smoothing"]["max_joint_iterations"]) == \
-        (20, 100)
+    assert (report["smoothing"]["max_sweeps"], report["smoothing"]["max_joint_iterations"],
+            report["smoothing"]["max_joint_rounds"]) == (20, 100, 3)
+    _, one_round = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_joint_rounds=1)
+    assert one_round["smoothing"]["check"]["min_scaled_jacobian"] == 0.4893584069476542
+    assert one_round["smoothing"]["stats"]["joint_rounds"] == 1
     # A smaller budget: faster, lower (refine --smooth-sweeps 2 --smooth-joint-iterations 0).
     _, budget = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=2,
                                  smooth_joint_iterations=0)
@@ -175,6 +179,10 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=0)
     with pytest.raises(ValueError, match="smooth_joint_iterations needs smooth=True"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth_joint_iterations=5)
+    with pytest.raises(ValueError, match="smooth_joint_rounds needs smooth=True"):
+        hexrefine.refine(mesh, "sphere:0,0,0,5", smooth_joint_rounds=2)
+    with pytest.raises(ValueError, match="smooth_joint_rounds must be in 1..1000"):
+        hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_joint_rounds=0)
 
 
 # --- errors --------------------------------------------------------------------------------------

@@ -136,7 +136,8 @@ def write_report(result, out_dir):
     if default:
         md += ["", "The default budget's cases below 0.5 x the parents (%d of %d), worst first:" % (
             len(misses), len(default)), ""]
-        md += ["- %s %s %s: %.3f" % (mesh, case, method, q) for q, mesh, case, method in misses]
+        md += ["- `%s` %s: %.3f" % (case.replace("/work/corpus:", ""), method, q)
+               for q, _, case, method in misses]
     (out_dir / "smoothing_budget.md").write_text("\n".join(md) + "\n")
 
 

@@ -115,14 +115,15 @@ constexpr int64_t chunk_hexes = 512;
 
 /// The edge-ratio sample of a hex whose cap is finite: sharpness (1 - ratio / cap), where the
 /// ratio (hex_edge_ratio) is within the last 1/sharpness of its cap and its longest or shortest
-/// edge has an end in `moves`, else +inf (no sample: far from the cap, or a constant no variable
-/// changes, which could only hold the soft minimum's reference down). It joins the scaled
-/// Jacobian samples in the soft minimum, so an iterate nearing a hex's cap is steered along the
-/// cap instead of being cut back to nothing by the line search (a hex the sweeps left at its
-/// cap otherwise stops the ascent at its first step). With `gradient`, adds weight * d sample /
-/// d p[v] to gradient[v]. -inf for a zero-length edge (an infeasible point).
+/// edge has a variable end (`vars`: per corner its variable, -1 for none), else +inf (no sample:
+/// far from the cap, or a constant no variable changes, which could only hold the soft minimum's
+/// reference down). It joins the scaled Jacobian samples in the soft minimum, so an iterate nearing
+/// a hex's cap is steered along the cap instead of being cut back to nothing by the line search (a
+/// hex the sweeps left at its cap otherwise stops the ascent at its first step). With `gradient`,
+/// adds weight * d sample / d p[v] to gradient[v]. -inf for a zero-length edge (an infeasible
+/// point).
 constexpr double cap_sample_sharpness = 20;
-double hex_cap_sample(const Corners& p, double cap, const std::array<bool, 8>& moves,
+double hex_cap_sample(const Corners& p, double cap, const std::array<int32_t, 8>& vars,
                       double weight = 0, Corners* gradient = nullptr) {
   if (!std::isfinite(cap)) return std::numeric_limits<double>::infinity();
   int shortest = 0, longest = 0;
@@ -136,7 +137,9 @@ double hex_cap_sample(const Corners& p, double cap, const std::array<bool, 8>& m
   const double ratio = length[longest] / length[shortest];
   const double sharpness = cap_sample_sharpness;
   if (ratio < (1 - 1 / sharpness) * cap) return std::numeric_limits<double>::infinity();
-  const auto edge_moves = [&](int e) { return moves[hex_edges[e][0]] || moves[hex_edges[e][1]]; };
+  const auto edge_moves = [&](int e) {
+    return vars[hex_edges[e][0]] >= 0 || vars[hex_edges[e][1]] >= 0;
+  };
   if (!edge_moves(longest) && !edge_moves(shortest)) return std::numeric_limits<double>::infinity();
   if (gradient && weight != 0) {
     // d ratio = ratio (d L_long / L_long - d L_short / L_short), d L = u / L on the edge's end.
@@ -250,7 +253,6 @@ class JointProblem {
       std::array<bool, 8> corner_moves;
       for (int c = 0; c < 8; ++c) corner_moves[c] = vars[c] >= 0;
       hexes_.push_back(problem.hexes[j]);
-      hex_moves_.push_back(corner_moves);
       edge_caps_.push_back(
           hex_edge_ratio_cap(hex_points(mesh_, problem.hexes[j]), options.max_edge_ratio));
       hex_vars_.push_back(vars);
@@ -329,8 +331,8 @@ class JointProblem {
             (edge_caps_[g] != none && !(hex_edge_ratio(pg) <= edge_caps_[g])))
           m = -std::numeric_limits<double>::infinity();
         if (options_.cap_samples) {
-          cap_samples_[h] = hex_cap_sample(ph, edge_caps_[h], hex_moves_[h]);
-          cap_samples_[g] = hex_cap_sample(pg, edge_caps_[g], hex_moves_[g]);
+          cap_samples_[h] = hex_cap_sample(ph, edge_caps_[h], hex_vars_[h]);
+          cap_samples_[g] = hex_cap_sample(pg, edge_caps_[g], hex_vars_[g]);
         }
       }
       double cap_min = std::numeric_limits<double>::infinity();
@@ -390,7 +392,7 @@ class JointProblem {
           const Corners p = hex_points(mesh_, hexes_[h]);
           hex_samples(p, unused, &weights, &hex_gradient_[h]);
           if (cap_weight != 0)
-            hex_cap_sample(p, edge_caps_[h], hex_moves_[h], cap_weight, &hex_gradient_[h]);
+            hex_cap_sample(p, edge_caps_[h], hex_vars_[h], cap_weight, &hex_gradient_[h]);
         } else {
           for (Vec3& g : hex_gradient_[h]) g.setZero();
         }
@@ -441,9 +443,8 @@ class JointProblem {
   std::vector<int32_t> hexes_;                    // objective hexes (mesh ids)
   std::vector<double> edge_caps_;                 // per objective hex: hex_edge_ratio_cap
   std::vector<std::array<int32_t, 8>> hex_vars_;  // per objective hex: corner variables
-  std::vector<uint16_t> masks_;  // per objective hex: its samples that move (sample_mask)
-  std::vector<std::array<bool, 8>> hex_moves_;      // per objective hex: its variable corners
-  std::vector<int32_t> var_offsets_;                // variable -> var_items_
+  std::vector<uint16_t> masks_;       // per objective hex: its samples that move (sample_mask)
+  std::vector<int32_t> var_offsets_;  // variable -> var_items_
   std::vector<std::pair<int32_t, int>> var_items_;  // (objective hex, corner)
   std::vector<std::array<double, 9>> samples_;      // per objective hex
   std::vector<Corners> hex_gradient_;               // per objective hex, per corner

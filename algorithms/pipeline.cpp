@@ -14,6 +14,7 @@
 #include "mesh/error.hpp"
 #include "mesh/parallel.hpp"
 #include "mesh/quality.hpp"
+#include "mesh/reference_surface.hpp"
 #include "mesh/selection.hpp"
 #include "mesh/staged_write.hpp"
 
@@ -309,6 +310,8 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     const BoundaryReference reference =
         boundary_reference_build(input, topology_build(input, TopologyParts::faces));
     so.reference = &reference;
+    const ReferenceSurface reference_surface(input, o.refine.threads);
+    if (o.smoothing_surface_guard) so.reference_surface = &reference_surface;
     so.reference_nodes = input.point_count();
     so.threads = o.refine.threads;
     const std::vector<Eigen::Vector3d> unsmoothed = r.mesh.points;
@@ -318,12 +321,14 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     clock.begin("check (smoothed)");
     r.smoothed_check.emplace();
     r.smoothed_children_min_scaled_jacobian.emplace();
-    // Smoothing never fails a valid refinement: where the checker rejects the smoothed mesh
-    // (a boundary face its nodes slid across a strongly curved input patch, say), the nodes of
-    // the defect hexes and of the hexes around them go back to their unsmoothed positions,
-    // round by round; after smoothing_undo_rounds rounds all of them do. The refined mesh
-    // passed the same check, so the last resort is valid.
-    bool smoothed_again = false;
+    // Smoothing never fails a valid refinement. The surface guard keeps the faces it moves on
+    // the input surface as the checker tests it; should the checker still reject the smoothed
+    // mesh, it is smoothed again with the corners of the rejected hexes pinned (at most
+    // smoothing_pin_rounds times), and then the nodes of the defect hexes and of the hexes
+    // around them go back to their unsmoothed positions, round by round; after
+    // smoothing_undo_rounds rounds all of them do. The refined mesh passed the same check, so
+    // the last resort is valid.
+    int pin_rounds = 0;
     for (int round = 0;; ++round) {
       const bool whole = round == smoothing_undo_rounds;
       if (mesh_check_and_write("check_smoothed", *r.smoothed_check,
@@ -340,19 +345,25 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
         why += (why.empty() ? "" : "; ") + d;
       if (r.smoothing_warning.empty())
         r.smoothing_warning = "the smoothed mesh failed the check (" + why + ")";
-      // Later rounds of joint ascent slide boundary nodes furthest; one round often passes where
-      // three did not (cbml_bone random:0.02,2, selective: 0.271 after one round, where undoing
-      // around the rejected face of three left 0.087). So smooth once more from the refined mesh
-      // with one round before undoing anything; its time counts as smoothing.
-      if (!smoothed_again && so.joint_rounds > 1 && so.joint_iterations > 0) {
-        smoothed_again = true;
-        clock.end("check (smoothed)");
+      // The rejected faces are where a boundary node slid too far (their corners on the input
+      // surface, the face cutting a chord across a bend). Pin the corners of the defect hexes at
+      // their unsmoothed positions and smooth again from the refined mesh, up to
+      // o.smoothing_pin_rounds times, before undoing anything: undoing afterwards also takes back
+      // the moves that lifted the worst hexes (phm_rabbit random:0.02,1, selective: 0.058
+      // smoothed, 0.011 after the undo).
+      if (pin_rounds < o.smoothing_pin_rounds && !r.smoothed_check->defect_hexes.empty()) {
+        ++pin_rounds;
+        clock.end("check_smoothed");  // the undo bookkeeping since the check
+        for (int32_t h : r.smoothed_check->defect_hexes)
+          for (int32_t v : r.mesh.hexes[h]) so.fixed_nodes.push_back(v);
+        std::sort(so.fixed_nodes.begin(), so.fixed_nodes.end());
+        so.fixed_nodes.erase(std::unique(so.fixed_nodes.begin(), so.fixed_nodes.end()),
+                             so.fixed_nodes.end());
         r.mesh.points = unsmoothed;
-        so.joint_rounds = 1;
+        clock.begin("smooth");
         const double first_seconds = r.smoothing->seconds;
         r.smoothing = mesh_smooth(r.mesh, so);
         r.smoothing->seconds += first_seconds;
-        r.smoothing_warning += "; smoothed again with one round of joint ascent";
         clock.end("smooth");
         round = -1;  // the undo rounds start again for the new smoothing
         continue;
@@ -393,6 +404,11 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
       }
       r.smoothing_nodes_undone += undone;
     }
+    if (pin_rounds > 0)
+      r.smoothing_warning += "; smoothed again " + std::to_string(pin_rounds) +
+                             (pin_rounds == 1 ? " time" : " times") + " with " +
+                             std::to_string(so.fixed_nodes.size()) +
+                             " nodes of rejected hexes pinned";
     if (r.smoothing_nodes_undone > 0) {
       r.smoothing_warning += "; " + std::to_string(r.smoothing_nodes_undone) +
                              " smoothed nodes went back to their unsmoothed positions";

@@ -16,11 +16,14 @@
 /// Smoothing (optional) moves the nodes of the refined region and two layers around it
 /// (algorithms/placement/smoothing.hpp), boundary nodes on the input's boundary surface (the
 /// input's own boundary nodes too, over the input faces around them), and the result is checked
-/// against the input again. Smoothing never turns a valid refinement into an error: where the
-/// checker rejects the smoothed mesh, the smoothed nodes around the defects go back to their
-/// unsmoothed positions (at worst all of them), the report's smoothing.warning says so and
-/// smoothing.nodes_undone counts them. An error names the stage that failed: the input only
-/// when the input itself fails the checker.
+/// against the input again. The smoothing keeps every boundary face it moves passing the
+/// checker's own surface test (mesh/reference_surface.hpp), so the check agrees with it by
+/// construction. Smoothing never turns a valid refinement into an error: should the checker
+/// still reject the smoothed mesh, it is smoothed again from the refined mesh with the corners
+/// of the rejected hexes pinned (smoothing_pin_rounds times at most), and then the smoothed nodes
+/// around the defects go back to their unsmoothed positions (at worst all of them); the report's
+/// smoothing.warning says so and smoothing.nodes_undone counts them. An error names the stage that
+/// failed: the input only when the input itself fails the checker.
 
 #include <cstdint>
 #include <iosfwd>
@@ -67,6 +70,12 @@ struct PipelineOptions {
   /// How to smooth: the region is the refined hexes (region_hexes is replaced) and two layers
   /// around them; the reference is the input.
   SmoothOptions smoothing = pipeline_smoothing_defaults();
+  /// false: the smoothing moves boundary nodes without the checker's surface test (its
+  /// reference_surface unset), which the checker may then reject; for ablation and for the
+  /// tests of the retries above.
+  bool smoothing_surface_guard = true;
+  /// >= 0: smoothings again with the rejected hexes' corners pinned before any node is undone.
+  int smoothing_pin_rounds = 3;
   /// Refuse before refining when n * 27^passes could exceed this many output hexes (int32 ids).
   int64_t max_hexes = std::numeric_limits<int32_t>::max();
   MeshWriteOptions write;  ///< how pipeline_run_files writes the output

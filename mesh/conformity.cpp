@@ -23,6 +23,7 @@
 #include "mesh/quad_grid.hpp"
 #include "mesh/quad_patch.hpp"
 #include "mesh/quality.hpp"
+#include "mesh/reference_surface.hpp"
 
 namespace hexrefine {
 
@@ -77,35 +78,6 @@ std::vector<int32_t> boundary_faces_where(int threads, const BoundarySurface& su
   std::vector<int32_t> out;
   for (const std::vector<int32_t>& list : found) out.insert(out.end(), list.begin(), list.end());
   return out;
-}
-
-/// A boundary face across reference faces (see conformity.hpp): each corner on a reference face
-/// whose normal is within mesh_check_across_angle_degrees of the face's, the centroid within
-/// mesh_check_across_chord x the face's diameter of a reference face near it. Conservative: a
-/// reference face registered in none of the five cells looked at is missed (the face is then
-/// reported non-conformal, never the reverse).
-bool face_lies_across_reference(const Quad& q, const QuadGrid& grid,
-                                const BoundarySurface& reference) {
-  const Eigen::Vector3d normal = quad_unit_normal(q);
-  if (normal.isZero()) return false;
-  const double cos_limit = std::cos(mesh_check_across_angle_degrees * std::numbers::pi / 180);
-  for (int k = 0; k < 4; ++k) {
-    const bool found = grid.find(q[k], [&](int32_t j) {
-      return std::abs(quad_unit_normal(reference.quads[j]).dot(normal)) >= cos_limit;
-    });
-    if (!found) return false;
-  }
-  // The centroid may lie over a reference face none of the corners is on (a corner slid into a
-  // diagonal neighbour): the faces near it are those of its grid cell and of its corners' cells.
-  const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
-  const double chord = mesh_check_across_chord * quad_diameter(q);
-  const auto near = [&](int32_t j) {
-    return quad_within(reference.quads[j], centroid, reference.tolerances[j] + chord);
-  };
-  if (grid.visit_cell(centroid, near)) return true;
-  for (const Eigen::Vector3d& c : q)
-    if (grid.visit_cell(c, near)) return true;
-  return false;
 }
 
 /// Two boundary faces of one mesh that touch: every corner of `face` is a node of `other` or
@@ -622,24 +594,14 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   // lying on another boundary face of this mesh.
   std::vector<int32_t> non_conformal;  // indices into surface
   if (reference) {
-    const BoundarySurface reference_surface = boundary_surface(
-        *reference, hex_face_adjacency_build(*reference, threads, false).boundary_faces, threads);
-    const QuadGrid grid(reference_surface.quads, reference_surface.tolerances);
+    const ReferenceSurface reference_surface(*reference, threads);
     non_conformal = boundary_faces_where(threads, surface, [&](int32_t i) {
-      const Quad& q = surface.quads[i];
-      const Eigen::Vector3d centroid = (q[0] + q[1] + q[2] + q[3]) / 4.0;
-      const bool on_reference = grid.find(centroid, [&](int32_t j) {
-        for (const Eigen::Vector3d& c : q)
-          if (!quad_within(reference_surface.quads[j], c, reference_surface.tolerances[j]))
-            return false;
-        return true;
-      });
-      return !on_reference && !face_lies_across_reference(q, grid, reference_surface);
+      return !reference_surface_holds_face(reference_surface, surface.quads[i]);
     });
     r.reference_compared = true;
     r.reference_volume = mesh_volume(*reference);
     r.reference_planar_faced = true;
-    for (const Quad& q : reference_surface.quads) {
+    for (const Quad& q : reference_surface.quads()) {
       r.reference_boundary_area += quad_area(q);
       if (quad_relative_warp(q) > 1e-12) r.reference_planar_faced = false;
     }

@@ -236,6 +236,16 @@ class JointProblem {
         var_problem_.push_back(i);
         if (problem.slides[i].kind != SlideKind::free) sliding_.push_back(var_of[i]);
       }
+    // The boundary faces of the sliding variables, each once: an accepted step keeps them on
+    // the reference surface (NodeProblem::surface), or the line search cuts it.
+    if (problem.surface && !problem.node_face_offsets.empty()) {
+      for (int32_t v : sliding_)
+        for (int32_t k = problem.node_face_offsets[var_problem_[v]];
+             k < problem.node_face_offsets[var_problem_[v] + 1]; ++k)
+          guard_faces_.push_back(problem.node_face[k]);
+      std::sort(guard_faces_.begin(), guard_faces_.end());
+      guard_faces_.erase(std::unique(guard_faces_.begin(), guard_faces_.end()), guard_faces_.end());
+    }
     // Where each sliding variable is on its slide: the projections' warm starts.
     states_.resize(sliding_.size());
     for (size_t k = 0; k < sliding_.size(); ++k)
@@ -313,6 +323,21 @@ class JointProblem {
     }
   }
 
+  /// Whether the boundary faces of the sliding variables lie on the reference surface at the
+  /// positions the last set_position() or evaluate() made (NodeProblem::surface; true without).
+  /// Asked only of a step the line search would accept: the test projects onto patches and
+  /// costs more than the step's KS.
+  bool faces_on_surface() const {
+    for (int32_t f : guard_faces_) {
+      const auto& q = problem_.faces[f];
+      if (!reference_surface_holds_face(
+              *problem_.surface,
+              {mesh_.points[q[0]], mesh_.points[q[1]], mesh_.points[q[2]], mesh_.points[q[3]]}))
+        return false;
+    }
+    return true;
+  }
+
   /// At x: KS (-inf where a sample is not finite or a hex is past its edge-ratio cap: an
   /// infeasible point), the minimum sample and, with `gradient`,
   /// d KS / d x.
@@ -350,6 +375,7 @@ class JointProblem {
     min = std::numeric_limits<double>::infinity();
     for (double m : chunk_min_) min = std::min(min, m);
     if (!std::isfinite(min)) return -std::numeric_limits<double>::infinity();
+
     // The soft minimum's reference: the least of the scaled Jacobian and cap samples (`min`,
     // returned, is the scaled Jacobians' alone: what the ascent keeps the best iterate by).
     double floor = min;
@@ -436,12 +462,13 @@ class JointProblem {
   HexMesh& mesh_;
   const NodeProblem& problem_;
   const JointAscentOptions& options_;
-  std::vector<int32_t> nodes_;                    // variable -> mesh node
-  std::vector<int32_t> var_problem_;              // variable -> problem node
-  std::vector<int32_t> sliding_;                  // the sliding variables, ascending
-  std::vector<SlideState> states_;                // per sliding variable
-  std::vector<int32_t> hexes_;                    // objective hexes (mesh ids)
-  std::vector<double> edge_caps_;                 // per objective hex: hex_edge_ratio_cap
+  std::vector<int32_t> nodes_;        // variable -> mesh node
+  std::vector<int32_t> var_problem_;  // variable -> problem node
+  std::vector<int32_t> sliding_;      // the sliding variables, ascending
+  std::vector<SlideState> states_;    // per sliding variable
+  std::vector<int32_t> hexes_;        // objective hexes (mesh ids)
+  std::vector<double> edge_caps_;     // per objective hex: hex_edge_ratio_cap
+  std::vector<int32_t> guard_faces_;  // NodeProblem::faces a sliding variable is a corner of
   std::vector<std::array<int32_t, 8>> hex_vars_;  // per objective hex: corner variables
   std::vector<uint16_t> masks_;       // per objective hex: its samples that move (sample_mask)
   std::vector<int32_t> var_offsets_;  // variable -> var_items_
@@ -517,7 +544,7 @@ JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
   Eigen::VectorXd x = start, gradient, best = start;
   double min, best_min;
   double value = joint.evaluate(x, min, &gradient);
-  if (!std::isfinite(value)) {  // the start past a cap: nothing to ascend from
+  if (!std::isfinite(value) || !joint.faces_on_surface()) {  // the start past a cap or guard
     joint.restore(start);
     return stats;
   }
@@ -562,7 +589,7 @@ JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
     for (int halving = 0; halving < 30; ++halving, t *= 0.5) {
       trial = x + t * d;
       trial_value = joint.evaluate(trial, trial_min, nullptr);
-      if (trial_value >= value + 1e-4 * t * slope) {
+      if (trial_value >= value + 1e-4 * t * slope && joint.faces_on_surface()) {
         accepted = true;
         break;
       }

@@ -31,7 +31,10 @@
 /// Every candidate goes through one guard: the worst hex around the node must improve (or, for
 /// the Laplacian and Newton candidates, stay and the sum of their scaled Jacobians rise), and
 /// with keep_positive no hex with a positive scaled Jacobian may become non-positive. Hexes
-/// elsewhere do not change, so the minimum over the problem never decreases.
+/// elsewhere do not change, so the minimum over the problem never decreases. With a surface
+/// guard (NodeProblem::surface) the visit must also end with every boundary face at the node on
+/// the reference surface as the checker tests it; else it goes back to the latest position it
+/// passed through that does (its start does).
 /// Sweeps visit the active nodes worst first (counting sort of the local minimum, ties by node
 /// id); the movable nodes of the hexes around a node that moved become active for the next
 /// sweep; they stop after max_sweeps, when no node is active, or when a sweep moved no node by
@@ -100,6 +103,17 @@ void hex_scaled_jacobian_gradients(const std::array<Vec3, 8>& p, int vertex,
     a[k] /= 4.0;
   }
   sample(a, c, 8);
+}
+
+bool node_faces_on_surface(const NodeProblem& problem, const HexMesh& mesh, int32_t i) {
+  if (!problem.surface || problem.node_face_offsets.empty()) return true;
+  for (int32_t k = problem.node_face_offsets[i]; k < problem.node_face_offsets[i + 1]; ++k) {
+    const auto& f = problem.faces[problem.node_face[k]];
+    if (!reference_surface_holds_face(*problem.surface, {mesh.points[f[0]], mesh.points[f[1]],
+                                                         mesh.points[f[2]], mesh.points[f[3]]}))
+      return false;
+  }
+  return true;
 }
 
 double hex_edge_ratio_cap(const HexCorners& p, double limit) {
@@ -215,9 +229,27 @@ class Optimizer {
   double visit(int32_t i) {
     const Vec3 before = mesh_.points[problem_.nodes[i]];
     if (!(local_min(i) < options_.visit_below)) return 0.0;
+    // The surface guard (NodeProblem::surface) projects onto patches and costs more than a
+    // candidate's quality: it is asked once, of where the visit ends, and only if that fails
+    // of the positions the visit went through, latest first (the visit's start passed it).
+    guard_deferred_ = problem_.surface && !problem_.node_face_offsets.empty() &&
+                      problem_.node_face_offsets[i + 1] > problem_.node_face_offsets[i];
+    visited_.clear();
+    visited_.push_back({before, state_[i]});
     if (options_.laplacian) laplacian(i);
     if (options_.mean_ratio) mean_ratio_newton(i);
     if (options_.ascent) ascent(i);
+    if (guard_deferred_) {
+      guard_deferred_ = false;
+      if (visited_.size() > 1 && !node_faces_on_surface(problem_, mesh_, i)) {
+        size_t k = visited_.size() - 1;
+        while (k > 0) {
+          --k;
+          restore_visited(i, visited_[k]);
+          if (k == 0 || node_faces_on_surface(problem_, mesh_, i)) break;
+        }
+      }
+    }
     return (mesh_.points[problem_.nodes[i]] - before).norm();
   }
 
@@ -252,6 +284,15 @@ class Optimizer {
     const Vec3 x = slide_project(i, mesh_.points[node], s);
     state_[i] = s;
     if (x != mesh_.points[node]) {
+      // A node an earlier ascent left at the edge of the surface guard (on its slide up to
+      // the projection's rounding) stays rather than be projected across that edge.
+      if (!problem_.node_face_offsets.empty()) {
+        const Vec3 keep = mesh_.points[node];
+        mesh_.points[node] = x;
+        const bool on_surface = node_faces_on_surface(problem_, mesh_, i);
+        mesh_.points[node] = keep;
+        if (!on_surface) return;
+      }
       double m;
       trial_min(i, x, m);
       commit(i, x, s);
@@ -304,6 +345,7 @@ class Optimizer {
         break;
       }
     }
+    if (allowed && !guard_deferred_) allowed = node_faces_on_surface(problem_, mesh_, i);
     mesh_.points[node] = keep;
     if (sum_gain) *sum_gain = gain;
     return allowed;
@@ -312,6 +354,7 @@ class Optimizer {
   void commit(int32_t i, const Vec3& x, const SlideState& s) {
     mesh_.points[problem_.nodes[i]] = x;
     state_[i] = s;
+    if (guard_deferred_) visited_.push_back({x, s});
     size_t t = 0;
     for (int32_t k = problem_.node_hex_offsets[i]; k < problem_.node_hex_offsets[i + 1]; ++k)
       quality_[problem_.node_hex[k]] = trial_[t++];
@@ -515,6 +558,17 @@ class Optimizer {
     shared_.soft_phase = soft;
     shared_.beta = beta;
   }
+  /// Puts node i back where the visit was (a position it committed), qualities updated.
+  void restore_visited(int32_t i, const std::pair<Vec3, SlideState>& at) {
+    double m;
+    trial_min(i, at.first, m);
+    mesh_.points[problem_.nodes[i]] = at.first;
+    state_[i] = at.second;
+    size_t t = 0;
+    for (int32_t k = problem_.node_hex_offsets[i]; k < problem_.node_hex_offsets[i + 1]; ++k)
+      quality_[problem_.node_hex[k]] = trial_[t++];
+  }
+
   /// Moves node i to x (a saved position), its state and the qualities updated.
   void restore(int32_t i, const Vec3& x) {
     SlideState s = state_[i];
@@ -533,6 +587,8 @@ class Optimizer {
   std::vector<SlideState>& state_;
   OptimizerShared& shared_;
   std::vector<double> trial_, samples_;  // this worker's scratch
+  bool guard_deferred_ = false;          // in a visit whose surface guard runs at its end
+  std::vector<std::pair<Vec3, SlideState>> visited_;  // where the visit went, its start first
   std::vector<Vec3> sample_gradients_;
 };
 

@@ -12,6 +12,7 @@
 #include "algorithms/placement/node_slide.hpp"
 #include "mesh/hex_mesh.hpp"
 #include "mesh/quality.hpp"
+#include "mesh/reference_surface.hpp"
 
 namespace hexrefine {
 
@@ -26,7 +27,19 @@ struct NodeProblem {
   /// move): whom a move wakes, without a search per corner.
   std::vector<std::array<int32_t, 8>> hex_local_nodes;
   SlideGeometry geometry;
+  /// Optional (smoothing against the input of a refinement): `surface` and, per movable node,
+  /// the boundary faces of the mesh it is a corner of (CSR into `faces`: mesh node ids in cyclic
+  /// order). A move of the node is kept only if each of them still lies on the surface
+  /// (reference_surface_holds_face, the checker's own test), so no move leaves a face the
+  /// checker rejects. Empty offsets: no such guard.
+  const ReferenceSurface* surface = nullptr;
+  std::vector<std::array<int32_t, 4>> faces;
+  std::vector<int32_t> node_face_offsets, node_face;
 };
+
+/// Whether every boundary face of local node i lies on problem.surface at the mesh's current
+/// positions (true without a surface guard).
+bool node_faces_on_surface(const NodeProblem& problem, const HexMesh& mesh, int32_t i);
 
 /// The largest edge ratio a move may give the hex with corners p (its start):
 /// max(limit, hex_edge_ratio(p) (1 + 1e-9)), so that a hex already stretched beyond the limit

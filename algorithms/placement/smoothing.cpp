@@ -19,7 +19,12 @@
 ///       any angle when every input face is planar: there the facets are the geometry), and
 ///       stays at a corner (ReferenceSlides::at_input_node). Every boundary node stays on the
 ///       input's boundary surface; a boundary face may then straddle two input faces, which the
-///       checker accepts when its corners lie on the input surface (conformity.hpp). The
+///       checker accepts when its corners lie on the input surface and it does not cut a chord
+///       across a bend (conformity.hpp). With `reference_surface` every move keeps the faces at
+///       the moved node passing that same test (the surface guard: node visits and joint-ascent
+///       steps that would fail it are not kept), so the check agrees by construction; without
+///       it, a node slid over a bend of the input could leave a face the checker rejects
+///       (phm_rabbit: 6 of the real-mesh study's smoothings, undone node by node). The
 ///       transition children of a boundary parent are where refinement loses most quality,
 ///       and the input's own boundary nodes are half of their corners;
 ///     - without one: a boundary node slides on the boundary quads around it (their bilinear
@@ -48,10 +53,12 @@
 
 #include "algorithms/placement/node_joint_ascent.hpp"
 #include "algorithms/placement/node_optimizer.hpp"
+#include "mesh/conformity.hpp"
 #include "mesh/error.hpp"
 #include "mesh/hex_convention.hpp"
 #include "mesh/hex_face_adjacency.hpp"
 #include "mesh/quality.hpp"
+#include "mesh/reference_surface.hpp"
 
 namespace hexrefine {
 
@@ -194,6 +201,11 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
       throw InputError("mesh_smooth: region hex " + std::to_string(h) + " out of range 0.." +
                        std::to_string(mesh.hex_count() - 1));
 
+  for (int32_t v : options.fixed_nodes)
+    if (v < 0 || v >= mesh.point_count())
+      throw InputError("mesh_smooth: fixed node " + std::to_string(v) + " out of range 0.." +
+                       std::to_string(mesh.point_count() - 1));
+
   SmoothStats stats;
   min_mean(mesh, stats.min_scaled_jacobian_before, stats.mean_scaled_jacobian_before);
 
@@ -225,6 +237,12 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
     for (size_t k = 0; k < part.size(); ++k) local_of_part[part[k]] = static_cast<int32_t>(k);
     for (int32_t h : region)
       for (int32_t v : sub.mesh.hexes[local_of_part[h]]) in_region[v] = 1;
+    if (!options.fixed_nodes.empty()) {
+      std::vector<uint8_t> fixed(mesh.points.size(), 0);
+      for (int32_t v : options.fixed_nodes) fixed[v] = 1;
+      for (size_t n = 0; n < in_region.size(); ++n)
+        if (fixed[sub.node_of[n]]) in_region[n] = 0;
+    }
   }
   NodeProblem problem;
   if (options.reference) {
@@ -233,8 +251,9 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
     // The part's boundary nodes and the hexes around each node, from matched faces and one
     // counting sort: no general topology (its edges and face ids) is needed here.
     std::vector<uint8_t> boundary(sub.mesh.points.size(), 0);
-    for (const HexFaceSlot& f :
-         hex_face_adjacency_build(sub.mesh, options.threads, false).boundary_faces)
+    const std::vector<HexFaceSlot> boundary_faces =
+        hex_face_adjacency_build(sub.mesh, options.threads, false).boundary_faces;
+    for (const HexFaceSlot& f : boundary_faces)
       for (int k = 0; k < 4; ++k) boundary[sub.mesh.hexes[f.hex][hex_faces[f.local_face][k]]] = 1;
     std::vector<int32_t> sub_hexes(sub.mesh.hexes.size()), hex_offsets, hex_items;
     std::iota(sub_hexes.begin(), sub_hexes.end(), 0);
@@ -278,6 +297,78 @@ SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options) {
     for (const auto& [node, slide] : movable) {
       problem.nodes.push_back(node);
       problem.slides.push_back(slide);
+    }
+    if (options.reference_surface) {
+      // The boundary faces at a sliding node (a face holding a region node is a boundary face
+      // of the whole mesh, see above), and per movable node the ones it is a corner of.
+      std::vector<int32_t> sliding_of_sub(sub.mesh.points.size(), -1);
+      for (const HexFaceSlot& f : boundary_faces)
+        for (int k = 0; k < 4; ++k) {
+          const int32_t v = sub.mesh.hexes[f.hex][hex_faces[f.local_face][k]];
+          const auto at =
+              std::lower_bound(problem.nodes.begin(), problem.nodes.end(), sub.node_of[v]);
+          if (at != problem.nodes.end() && *at == sub.node_of[v] &&
+              problem.slides[at - problem.nodes.begin()].kind != SlideKind::free)
+            sliding_of_sub[v] = static_cast<int32_t>(at - problem.nodes.begin());
+        }
+      problem.surface = options.reference_surface;
+      // A face needs the guard when a corner slides, unless every corner stays on one input
+      // face: its moving corners slide on that one patch and its fixed ones lie on it. Such a
+      // face passes the checker's first test whatever the moves (most faces of the region:
+      // the sub-faces of an input face), and skipping it halves the guard's cost.
+      const auto guarded = [&](const HexFaceSlot& f) {
+        int32_t patch = -1;
+        bool sliding = false, one_patch = true;
+        for (int k = 0; k < 4 && one_patch; ++k) {
+          const int32_t i = sliding_of_sub[sub.mesh.hexes[f.hex][hex_faces[f.local_face][k]]];
+          if (i < 0) continue;
+          sliding = true;
+          const NodeSlide& slide = problem.slides[i];
+          const int32_t item = problem.geometry.items[slide.first];
+          one_patch = slide.kind == SlideKind::patch && (patch < 0 || patch == item);
+          patch = item;
+        }
+        if (!sliding) return false;
+        if (!one_patch) return true;
+        const Quad& on = problem.geometry.patches[patch];
+        for (int k = 0; k < 4; ++k) {
+          const int32_t v = sub.mesh.hexes[f.hex][hex_faces[f.local_face][k]];
+          if (sliding_of_sub[v] < 0 &&
+              !quad_within(on, sub.mesh.points[v],
+                           mesh_check_surface_tolerance * quad_diameter(on)))
+            return true;
+        }
+        return false;
+      };
+      std::vector<uint8_t> face_guarded(boundary_faces.size());
+      problem.node_face_offsets.assign(problem.nodes.size() + 1, 0);
+      for (size_t fi = 0; fi < boundary_faces.size(); ++fi) {
+        const HexFaceSlot& f = boundary_faces[fi];
+        face_guarded[fi] = guarded(f);
+        if (!face_guarded[fi]) continue;
+        std::array<int32_t, 4> q;
+        for (int k = 0; k < 4; ++k) {
+          const int32_t v = sub.mesh.hexes[f.hex][hex_faces[f.local_face][k]];
+          q[k] = sub.node_of[v];
+          if (sliding_of_sub[v] >= 0) ++problem.node_face_offsets[sliding_of_sub[v] + 1];
+        }
+        problem.faces.push_back(q);
+      }
+      for (size_t i = 0; i < problem.nodes.size(); ++i)
+        problem.node_face_offsets[i + 1] += problem.node_face_offsets[i];
+      problem.node_face.resize(problem.node_face_offsets.back());
+      std::vector<int32_t> cursor(problem.node_face_offsets.begin(),
+                                  problem.node_face_offsets.end() - 1);
+      int32_t guarded_index = 0;
+      for (size_t fi = 0; fi < boundary_faces.size(); ++fi) {
+        if (!face_guarded[fi]) continue;
+        const HexFaceSlot& f = boundary_faces[fi];
+        for (int k = 0; k < 4; ++k) {
+          const int32_t i = sliding_of_sub[sub.mesh.hexes[f.hex][hex_faces[f.local_face][k]]];
+          if (i >= 0) problem.node_face[cursor[i]++] = guarded_index;
+        }
+        ++guarded_index;
+      }
     }
   } else {
     const HexTopology topology = topology_build(sub.mesh);

@@ -72,6 +72,16 @@ struct SmoothOptions {
   /// nullptr: boundary nodes slide on the mesh's own boundary quads (SmoothNodeKind).
   const BoundaryReference* reference = nullptr;
   int32_t reference_nodes = 0;
+  /// With `reference`, optional: the input's boundary surface as the checker sees it. A move is
+  /// then kept only if every boundary face at the moved node still passes the checker's test
+  /// (reference_surface_holds_face): a node slid over a bend of the input can leave a face whose
+  /// centroid sags off the surface (phm_rabbit random:0.02,1, selective), which
+  /// `check --reference` rejects. The same surface as check's, so the two agree.
+  const ReferenceSurface* reference_surface = nullptr;
+  /// Mesh node ids (in [0, node_count), any order) that stay where they are although in the
+  /// region: refine --smooth pins the corners of the boundary faces the checker rejected in a
+  /// first smoothing and smooths again (pipeline.cpp).
+  std::vector<int32_t> fixed_nodes;
   int threads = 1;  ///< >= 1: threads for the node visits (the result is the same for any count)
   /// optimize, >= 0: L-BFGS iterations per round of the joint ascent of the nodes around the
   /// worst hexes after the sweeps, interior nodes and boundary nodes on their slides
@@ -108,9 +118,9 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SmoothStats, min_scaled_jacobian
 
 /// Smooths `mesh` in place. Throws InputError for bad options (negative sweeps, layers or joint
 /// iterations, joint rounds below 1, feature
-/// angle outside (0, 180), visit_below outside (0, 1], region hex id out of range) or a mesh
-/// failing mesh_validate_ids or holding a non-finite coordinate. The min and mean before and after
-/// are over the whole mesh.
+/// angle outside (0, 180), visit_below outside (0, 1], region hex or fixed node id out of range) or
+/// a mesh failing mesh_validate_ids or holding a non-finite coordinate. The min and mean before and
+/// after are over the whole mesh.
 SmoothStats mesh_smooth(HexMesh& mesh, const SmoothOptions& options);
 
 /// The default region of `refine --smooth`: the refined and transition hexes, i.e. those whose

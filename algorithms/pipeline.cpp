@@ -267,6 +267,9 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
   // more than one thread (the writer takes a thread of its own; one thread: one after the
   // other). The written file becomes `out` only once the verdict allows it: returns false, with
   // nothing written, when it does not.
+  // The input's boundary surface, which both checks and the smoothing test faces against:
+  // built once, before the first check (its cost the check's).
+  std::optional<ReferenceSurface> input_surface;
   auto mesh_check_and_write = [&](const std::string& stage, MeshCheckReport& check,
                                   double& children_min_scaled_jacobian, bool final_mesh) {
     std::optional<StagedMeshWrite> staged;
@@ -274,7 +277,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
       clock.begin(stage == "check" ? "check and write" : "check (smoothed) and write");
       staged.emplace(out, r.mesh, o.write);
     }
-    check = mesh_check(r.mesh, &input, o.refine.threads);
+    check = mesh_check(r.mesh, &input, o.refine.threads, &*input_surface);
     children_min_scaled_jacobian = children_min(check);
     const double writer_cpu = staged ? staged->cpu_seconds_so_far() : 0.0;
     clock.end(stage);
@@ -299,6 +302,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     return true;
   };
 
+  input_surface.emplace(input, o.refine.threads);
   if (!mesh_check_and_write("check", r.check, r.children_min_scaled_jacobian,
                             smooth_region.empty()))
     refine_verdict_enforce(r.check, r.mesh, input, o, r.ablation);
@@ -310,8 +314,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     const BoundaryReference reference =
         boundary_reference_build(input, topology_build(input, TopologyParts::faces));
     so.reference = &reference;
-    const ReferenceSurface reference_surface(input, o.refine.threads);
-    if (o.smoothing_surface_guard) so.reference_surface = &reference_surface;
+    if (o.smoothing_surface_guard) so.reference_surface = &*input_surface;
     so.reference_nodes = input.point_count();
     so.threads = o.refine.threads;
     const std::vector<Eigen::Vector3d> unsmoothed = r.mesh.points;
@@ -329,6 +332,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     // smoothing_undo_rounds rounds all of them do. The refined mesh passed the same check, so
     // the last resort is valid.
     int pin_rounds = 0;
+    std::vector<int32_t> pinned;  // the corners of the rejected hexes, ascending
     for (int round = 0;; ++round) {
       const bool whole = round == smoothing_undo_rounds;
       if (mesh_check_and_write("check_smoothed", *r.smoothed_check,
@@ -355,10 +359,11 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
         ++pin_rounds;
         clock.end("check_smoothed");  // the undo bookkeeping since the check
         for (int32_t h : r.smoothed_check->defect_hexes)
-          for (int32_t v : r.mesh.hexes[h]) so.fixed_nodes.push_back(v);
-        std::sort(so.fixed_nodes.begin(), so.fixed_nodes.end());
-        so.fixed_nodes.erase(std::unique(so.fixed_nodes.begin(), so.fixed_nodes.end()),
-                             so.fixed_nodes.end());
+          for (int32_t v : r.mesh.hexes[h]) pinned.push_back(v);
+        std::sort(pinned.begin(), pinned.end());
+        pinned.erase(std::unique(pinned.begin(), pinned.end()), pinned.end());
+        so.fixed_nodes = o.smoothing.fixed_nodes;
+        so.fixed_nodes.insert(so.fixed_nodes.end(), pinned.begin(), pinned.end());
         r.mesh.points = unsmoothed;
         clock.begin("smooth");
         const double first_seconds = r.smoothing->seconds;

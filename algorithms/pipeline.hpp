@@ -74,7 +74,8 @@ struct PipelineOptions {
   /// reference_surface unset), which the checker may then reject; for ablation and for the
   /// tests of the retries above.
   bool smoothing_surface_guard = true;
-  /// >= 0: smoothings again with the rejected hexes' corners pinned before any node is undone.
+  /// Smoothings again with the rejected hexes' corners pinned before any node is undone (<= 0:
+  /// none).
   int smoothing_pin_rounds = 3;
   /// Refuse before refining when n * 27^passes could exceed this many output hexes (int32 ids).
   int64_t max_hexes = std::numeric_limits<int32_t>::max();

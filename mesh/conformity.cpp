@@ -467,7 +467,8 @@ int scaled_jacobian_bin(double v) {
 
 }  // namespace
 
-MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int threads) {
+MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int threads,
+                           const ReferenceSurface* reference_surface) {
   MeshCheckReport r;
   r.hexes = mesh.hex_count();
   r.nodes = mesh.point_count();
@@ -594,14 +595,15 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
   // lying on another boundary face of this mesh.
   std::vector<int32_t> non_conformal;  // indices into surface
   if (reference) {
-    const ReferenceSurface reference_surface(*reference, threads);
+    std::optional<ReferenceSurface> own_surface;
+    if (!reference_surface) reference_surface = &own_surface.emplace(*reference, threads);
     non_conformal = boundary_faces_where(threads, surface, [&](int32_t i) {
-      return !reference_surface_holds_face(reference_surface, surface.quads[i]);
+      return !reference_surface_holds_face(*reference_surface, surface.quads[i]);
     });
     r.reference_compared = true;
     r.reference_volume = mesh_volume(*reference);
     r.reference_planar_faced = true;
-    for (const Quad& q : reference_surface.quads()) {
+    for (const Quad& q : reference_surface->quads()) {
       r.reference_boundary_area += quad_area(q);
       if (quad_relative_warp(q) > 1e-12) r.reference_planar_faced = false;
     }

@@ -161,11 +161,15 @@ struct MeshCheckReport {
 /// How many defect hexes a report lists.
 inline constexpr size_t mesh_check_defect_hex_limit = 20;
 
+class ReferenceSurface;
+
 /// Checks `mesh` (and compares it with `reference`, the mesh before refinement, if given), on up
 /// to `threads` threads; the report is the same for every thread count. Throws InputError naming
-/// the hex if a node id is out of range or repeated within a hex.
-MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference = nullptr,
-                           int threads = 1);
+/// the hex if a node id is out of range or repeated within a hex. `reference_surface`: null, or
+/// ReferenceSurface(*reference) built by the caller (refine checks twice against its input and
+/// smooths against the same surface: built once).
+MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference = nullptr, int threads = 1,
+                           const ReferenceSurface* reference_surface = nullptr);
 
 /// All fields of the report under their own names, plus "valid" (the reference fields only when
 /// reference_compared).

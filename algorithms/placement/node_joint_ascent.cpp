@@ -338,6 +338,16 @@ class JointProblem {
     return true;
   }
 
+  /// Drops from the guard the faces failing at the current positions.
+  void unguard_failing_faces() {
+    std::erase_if(guard_faces_, [&](int32_t f) {
+      const auto& q = problem_.faces[f];
+      return !reference_surface_holds_face(
+          *problem_.surface,
+          {mesh_.points[q[0]], mesh_.points[q[1]], mesh_.points[q[2]], mesh_.points[q[3]]});
+    });
+  }
+
   /// At x: KS (-inf where a sample is not finite or a hex is past its edge-ratio cap: an
   /// infeasible point), the minimum sample and, with `gradient`,
   /// d KS / d x.
@@ -544,10 +554,15 @@ JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
   Eigen::VectorXd x = start, gradient, best = start;
   double min, best_min;
   double value = joint.evaluate(x, min, &gradient);
-  if (!std::isfinite(value) || !joint.faces_on_surface()) {  // the start past a cap or guard
+  if (!std::isfinite(value)) {  // the start past a cap: nothing to ascend from
     joint.restore(start);
     return stats;
   }
+  // A face the start's projection already takes past the surface guard (a node the sweeps
+  // left at the guard's edge, moved by the projection's rounding) is not guarded: the others
+  // must keep passing. Should the end fail the check there, the pipeline pins it and smooths
+  // again.
+  joint.unguard_failing_faces();
   best_min = min;
   const double cap = 0.25 * joint.mean_edge();
   std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> history;  // (s, y) of -KS

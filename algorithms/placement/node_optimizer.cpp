@@ -235,7 +235,8 @@ class Optimizer {
     guard_deferred_ = problem_.surface && !problem_.node_face_offsets.empty() &&
                       problem_.node_face_offsets[i + 1] > problem_.node_face_offsets[i];
     visited_.clear();
-    visited_.push_back({before, state_[i]});
+    visited_quality_.clear();
+    if (guard_deferred_) remember_visited(i, before, state_[i]);
     if (options_.laplacian) laplacian(i);
     if (options_.mean_ratio) mean_ratio_newton(i);
     if (options_.ascent) ascent(i);
@@ -245,7 +246,7 @@ class Optimizer {
         size_t k = visited_.size() - 1;
         while (k > 0) {
           --k;
-          restore_visited(i, visited_[k]);
+          restore_visited(i, k);
           if (k == 0 || node_faces_on_surface(problem_, mesh_, i)) break;
         }
       }
@@ -354,10 +355,10 @@ class Optimizer {
   void commit(int32_t i, const Vec3& x, const SlideState& s) {
     mesh_.points[problem_.nodes[i]] = x;
     state_[i] = s;
-    if (guard_deferred_) visited_.push_back({x, s});
     size_t t = 0;
     for (int32_t k = problem_.node_hex_offsets[i]; k < problem_.node_hex_offsets[i + 1]; ++k)
       quality_[problem_.node_hex[k]] = trial_[t++];
+    if (guard_deferred_) remember_visited(i, x, s);
   }
 
   /// Tries x0 + t (x - x0), t = 1, 1/2, 1/4, projected onto the slide; keeps the first whose
@@ -558,15 +559,22 @@ class Optimizer {
     shared_.soft_phase = soft;
     shared_.beta = beta;
   }
-  /// Puts node i back where the visit was (a position it committed), qualities updated.
-  void restore_visited(int32_t i, const std::pair<Vec3, SlideState>& at) {
-    double m;
-    trial_min(i, at.first, m);
-    mesh_.points[problem_.nodes[i]] = at.first;
-    state_[i] = at.second;
-    size_t t = 0;
+  /// Records where node i is in this visit and the qualities of the hexes around it there.
+  void remember_visited(int32_t i, const Vec3& x, const SlideState& s) {
+    visited_.push_back({x, s});
     for (int32_t k = problem_.node_hex_offsets[i]; k < problem_.node_hex_offsets[i + 1]; ++k)
-      quality_[problem_.node_hex[k]] = trial_[t++];
+      visited_quality_.push_back(quality_[problem_.node_hex[k]]);
+  }
+
+  /// Puts node i back at the visit's k-th recorded position with the qualities it had there
+  /// (copied, not recomputed: only node i moved during the visit, so they are exact).
+  void restore_visited(int32_t i, size_t k) {
+    mesh_.points[problem_.nodes[i]] = visited_[k].first;
+    state_[i] = visited_[k].second;
+    const int32_t first = problem_.node_hex_offsets[i],
+                  count = problem_.node_hex_offsets[i + 1] - first;
+    for (int32_t j = 0; j < count; ++j)
+      quality_[problem_.node_hex[first + j]] = visited_quality_[k * count + j];
   }
 
   /// Moves node i to x (a saved position), its state and the qualities updated.
@@ -589,6 +597,7 @@ class Optimizer {
   std::vector<double> trial_, samples_;  // this worker's scratch
   bool guard_deferred_ = false;          // in a visit whose surface guard runs at its end
   std::vector<std::pair<Vec3, SlideState>> visited_;  // where the visit went, its start first
+  std::vector<double> visited_quality_;  // per visited_ entry, the qualities around the node
   std::vector<Vec3> sample_gradients_;
 };
 

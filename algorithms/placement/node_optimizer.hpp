@@ -28,10 +28,11 @@ struct NodeProblem {
   std::vector<std::array<int32_t, 8>> hex_local_nodes;
   SlideGeometry geometry;
   /// Optional (smoothing against the input of a refinement): `surface` and, per movable node,
-  /// the boundary faces of the mesh it is a corner of (CSR into `faces`: mesh node ids in cyclic
-  /// order). A move of the node is kept only if each of them still lies on the surface
-  /// (reference_surface_holds_face, the checker's own test), so no move leaves a face the
-  /// checker rejects. Empty offsets: no such guard.
+  /// the boundary faces of the mesh it is a corner of that a move can take off the surface
+  /// (CSR into `faces`: mesh node ids in cyclic order; smoothing.cpp leaves out the faces whose
+  /// corners all stay on one input face). A node visit is kept only if it ends with each of
+  /// them on the surface (reference_surface_holds_face, the checker's own test), and a joint
+  /// ascent step only if it leaves them there. Empty offsets: no such guard.
   const ReferenceSurface* surface = nullptr;
   std::vector<std::array<int32_t, 4>> faces;
   std::vector<int32_t> node_face_offsets, node_face;

@@ -72,9 +72,10 @@ struct SmoothOptions {
   /// nullptr: boundary nodes slide on the mesh's own boundary quads (SmoothNodeKind).
   const BoundaryReference* reference = nullptr;
   int32_t reference_nodes = 0;
-  /// With `reference`, optional: the input's boundary surface as the checker sees it. A move is
-  /// then kept only if every boundary face at the moved node still passes the checker's test
-  /// (reference_surface_holds_face): a node slid over a bend of the input can leave a face whose
+  /// With `reference`, optional: the input's boundary surface as the checker sees it. A node
+  /// visit or joint-ascent step is then kept only if the boundary faces at the moved nodes still
+  /// pass the checker's test (reference_surface_holds_face; NodeProblem::surface says which
+  /// faces and when): a node slid over a bend of the input can leave a face whose
   /// centroid sags off the surface (phm_rabbit random:0.02,1, selective), which
   /// `check --reference` rejects. The same surface as check's, so the two agree.
   const ReferenceSurface* reference_surface = nullptr;

@@ -201,6 +201,27 @@ TEST_P(SmoothingMethods, OnlyNodesOfRegionHexesMove) {
     }
 }
 
+// SmoothOptions::fixed_nodes (the pipeline pins the corners of hexes the checker rejected):
+// listed nodes stay bit for bit although in the region, the others still move.
+TEST_P(SmoothingMethods, FixedNodesStayWhereTheyAre) {
+  const HexMesh input = jittered_brick(4, 4, 4, 0.3, true);
+  HexMesh free_run = input;
+  SmoothOptions o;
+  o.method = GetParam();
+  const SmoothStats free_stats = mesh_smooth(free_run, o);
+  std::vector<int32_t> moved;
+  for (int32_t n = 0; n < input.point_count(); ++n)
+    if (free_run.points[n] != input.points[n]) moved.push_back(n);
+  ASSERT_GE(moved.size(), 4u);
+  o.fixed_nodes = {moved[0], moved[moved.size() / 2], moved.back()};
+  HexMesh m = input;
+  const SmoothStats s = mesh_smooth(m, o);
+  for (int32_t n : o.fixed_nodes) EXPECT_TRUE(m.points[n] == input.points[n]) << "node " << n;
+  EXPECT_EQ(s.movable_nodes, free_stats.movable_nodes - 3);
+  EXPECT_GT(s.nodes_moved, 0);
+  EXPECT_GE(s.min_scaled_jacobian_after, s.min_scaled_jacobian_before);
+}
+
 TEST_P(SmoothingMethods, InvertedInputNeverGetsWorse) {
   HexMesh m = fixture_brick(3, 3, 3);
   // Node (1,1,1) pushed through the opposite corner: hex (0,0,0) inverted.
@@ -335,6 +356,11 @@ TEST(Smoothing, BadOptionsAreInputErrors) {
   m.points[13].y() = std::nan("");
   EXPECT_THROW(mesh_smooth(m, o), InputError);
   m.points[13].y() = 1;
+  o.fixed_nodes = {27};
+  EXPECT_THROW(mesh_smooth(m, o), InputError);
+  o.fixed_nodes = {-1};
+  EXPECT_THROW(mesh_smooth(m, o), InputError);
+  o = {};
   m.hexes[0][0] = 99;
   EXPECT_THROW(mesh_smooth(m, o), InputError);
 }

@@ -139,10 +139,16 @@ void boundary_input_hexes_around(const PlacementPass& pass, int32_t h, const Tem
 
 /// Step 0 (see the file comment): the parents whose children at the reference positions exceed
 /// the edge-ratio cap (max(cap, what the exact positions give the child)) get every new node of
-/// theirs at its exact position instead, except the nodes an alias gives to an adjusting hex;
-/// a node shared with a neighbour moves for the neighbour too, so the scan repeats (at most
-/// three times) over the parents of the children that changed. Only parents whose template has
+/// theirs at its exact position instead, except the nodes an alias gives to an adjusting hex
+/// (they are the adjusting hex's interior nodes, where its own template puts them); a node
+/// shared with a neighbour moves for the neighbour too, so the scan repeats (at most three
+/// times) over the parents of the children that changed. Only parents whose template has
 /// reference positions are scanned (boxes keep the exact ones). Returns how many parents.
+/// Known limit, measured: a child holding such a node can stay above its exact ratio
+/// (phm_metatron blob:90,1, selective: 22.1 against 21.2). Sending the adjusting hexes to their
+/// exact positions too fixes that case but leaves a child inverted elsewhere (ecr_cap's ball of
+/// Pipeline.PlacementFallbackMakesAFormerRefusalValid then needs 5 fallback untangles and
+/// changes the counts), so it is not done.
 int64_t parents_past_cap_to_exact(const PlacementPass& pass, HexMesh& refined, double cap) {
   if (!(cap > 0)) return 0;
   const auto& uses = pass.plan.uses;

@@ -148,7 +148,10 @@ void boundary_input_hexes_around(const PlacementPass& pass, int32_t h, const Tem
 /// (phm_metatron blob:90,1, selective: 22.1 against 21.2). Sending the adjusting hexes to their
 /// exact positions too fixes that case but leaves a child inverted elsewhere (ecr_cap's ball of
 /// Pipeline.PlacementFallbackMakesAFormerRefusalValid then needs 5 fallback untangles and
-/// changes the counts), so it is not done.
+/// changes the counts), and so does moving only the aliased nodes to the adjusting hex's exact
+/// positions where no hex holding them gets worse: the children there start closer to their
+/// exact ratios, so their caps are tighter and the optimizer no longer untangles the child that
+/// the looser caps let it untangle. So it is not done.
 int64_t parents_past_cap_to_exact(const PlacementPass& pass, HexMesh& refined, double cap) {
   if (!(cap > 0)) return 0;
   const auto& uses = pass.plan.uses;

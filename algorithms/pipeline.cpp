@@ -320,7 +320,39 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     const std::vector<Eigen::Vector3d> unsmoothed = r.mesh.points;
     clock.begin("smooth");
     r.smoothing = mesh_smooth(r.mesh, so);
+    // The start's guarantee (PipelineOptions::smoothing_start_fallback): the minimum plain
+    // `refine` reaches, placed by `optimized`.
+    double optimized_min = -std::numeric_limits<double>::infinity();
+    if (o.smoothing_start_fallback && o.refine.placement.method == PlacementMethod::untangle &&
+        !r.placement_used) {
+      RefineOptions optimized = o.refine;
+      optimized.placement.method = PlacementMethod::optimized;
+      try {
+        const RefineResult plain = refine(method, input, Targets{r.selected}, optimized);
+        const std::vector<double> q = mesh_scaled_jacobians(plain.mesh);
+        optimized_min = *std::min_element(q.begin(), q.end());
+      } catch (const PlacementError&) {
+        // optimized refuses: nothing to fall back on
+      }
+    }
     clock.end("smooth");
+    if (r.smoothing->min_scaled_jacobian_after < optimized_min) {
+      PipelineOptions again = o;
+      again.refine.placement.method = PlacementMethod::optimized;
+      PipelineResult b = pipeline_run_writing(input, again, out);
+      b.placement_used = PlacementMethod::optimized;
+      std::ostringstream why;
+      why << "smoothing from untangle reached " << r.smoothing->min_scaled_jacobian_after
+          << ", below the " << optimized_min
+          << " of the optimized placement unsmoothed; placed by optimized and smoothed from there";
+      b.placement_warning = why.str();
+      // The first start's stages count: both refinements, both smoothings.
+      for (const auto& [stage, seconds] : r.stage_seconds) b.stage_seconds[stage] += seconds;
+      for (const auto& [stage, seconds] : r.stage_cpu_seconds)
+        b.stage_cpu_seconds[stage] += seconds;
+      b.stage_seconds["total"] = seconds_since(start);
+      return b;
+    }
     clock.begin("check (smoothed)");
     r.smoothed_check.emplace();
     r.smoothed_children_min_scaled_jacobian.emplace();

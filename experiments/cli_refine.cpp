@@ -178,8 +178,9 @@ const CliCommand cli_refine_command = {
          "--smooth, the better start for it)"},
         {"--smooth", "",
          "smooth the refined region afterwards (checked again; starts from --placement untangle "
-         "unless a placement is given; a smoothing the checker rejects is undone, with a warning "
-         "in the report)"},
+         "unless a placement is given, and from optimized where untangle ends below plain "
+         "refine's minimum, with a warning; a smoothing the checker rejects is undone, with a "
+         "warning in the report)"},
         {"--smooth-sweeps", "N",
          "--smooth: at most N sweeps over the region's nodes before the joint ascent and N after "
          "each of its rounds, 1..1000000 (default 20; fewer: faster, lower minimum)"},

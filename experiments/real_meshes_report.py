@@ -173,6 +173,21 @@ def targets_section(rows):
     lower = [s for s in returned if s["smoothed"] is not None and s["smoothed"] < s["min"] - EPS]
     row("`--smooth` never below its unsmoothed minimum", "%d of %d" % (
         len(returned) - len(lower), len(returned)), not lower)
+    # Against plain refine: the default arm (optimized, unsmoothed) of the same case and method.
+    plain = {(s["folder"], s["mesh"], s["kind"], s["method"]): s["min"] for s in valid
+             if s["arm"] == "default" and not s["error"]}
+    paired = [s for s in returned if s["smoothed"] is not None and
+              (s["folder"], s["mesh"], s["kind"], s["method"]) in plain]
+    below_plain = [s for s in paired if s["smoothed"] < plain[
+        (s["folder"], s["mesh"], s["kind"], s["method"])] - EPS]
+    restarted = sum(1 for s in returned if s["placement"] == "optimized")
+    row("`--smooth` never below plain refine (the default placement, unsmoothed, same targets)",
+        "%d of %d (%d smoothed from optimized after untangle ended below it)%s" % (
+            len(paired) - len(below_plain), len(paired), restarted,
+            "" if not below_plain else "; below: " + "; ".join(
+                "%s %s %s %s < %s" % (s["mesh"], s["kind"], s["method"], fmt(s["smoothed"]),
+                                      fmt(plain[(s["folder"], s["mesh"], s["kind"], s["method"])]))
+                for s in below_plain[:6])), not below_plain)
     refined = [s for s in returned if s["parents_count"] > 0 and s["smoothed"] is not None]
     met = [s for s in refined if s["smoothed"] >= 0.5 * s["parents"] - EPS]
     row("smoothed >= 0.5 x the refined parents' minimum scaled Jacobian, every case",

@@ -113,6 +113,29 @@ void hex_samples(const Corners& p, std::array<double, 9>& samples,
 
 constexpr int64_t chunk_hexes = 512;
 
+/// The twelve edge lengths of a hex (hex_edges order) and which are the shortest and the
+/// longest: the feasibility test (the edge-ratio cap) and the cap sample both read them, so an
+/// evaluation takes them once per hex.
+struct HexEdgeLengths {
+  std::array<double, 12> length;
+  int shortest = 0, longest = 0;
+  /// hex_edge_ratio's value, bit for bit (the same norms, the same quotient).
+  double ratio() const {
+    if (!(length[shortest] > 0.0)) return hex_metric_max;
+    return std::min(length[longest] / length[shortest], hex_metric_max);
+  }
+};
+
+HexEdgeLengths hex_edge_lengths(const Corners& p) {
+  HexEdgeLengths l;
+  for (int e = 0; e < 12; ++e) {
+    l.length[e] = (p[hex_edges[e][1]] - p[hex_edges[e][0]]).norm();
+    if (l.length[e] < l.length[l.shortest]) l.shortest = e;
+    if (l.length[e] > l.length[l.longest]) l.longest = e;
+  }
+  return l;
+}
+
 /// The edge-ratio sample of a hex whose cap is finite: sharpness (1 - ratio / cap), where the
 /// ratio (hex_edge_ratio) is within the last 1/sharpness of its cap and its longest or shortest
 /// edge has a variable end (`vars`: per corner its variable, -1 for none), else +inf (no sample:
@@ -123,16 +146,12 @@ constexpr int64_t chunk_hexes = 512;
 /// adds weight * d sample / d p[v] to gradient[v]. -inf for a zero-length edge (an infeasible
 /// point).
 constexpr double cap_sample_sharpness = 20;
-double hex_cap_sample(const Corners& p, double cap, const std::array<int32_t, 8>& vars,
-                      double weight = 0, Corners* gradient = nullptr) {
+double hex_cap_sample(const Corners& p, const HexEdgeLengths& lengths, double cap,
+                      const std::array<int32_t, 8>& vars, double weight = 0,
+                      Corners* gradient = nullptr) {
   if (!std::isfinite(cap)) return std::numeric_limits<double>::infinity();
-  int shortest = 0, longest = 0;
-  std::array<double, 12> length;
-  for (int e = 0; e < 12; ++e) {
-    length[e] = (p[hex_edges[e][1]] - p[hex_edges[e][0]]).norm();
-    if (length[e] < length[shortest]) shortest = e;
-    if (length[e] > length[longest]) longest = e;
-  }
+  const std::array<double, 12>& length = lengths.length;
+  const int shortest = lengths.shortest, longest = lengths.longest;
   if (!(length[shortest] > 0)) return -std::numeric_limits<double>::infinity();
   const double ratio = length[longest] / length[shortest];
   const double sharpness = cap_sample_sharpness;
@@ -361,13 +380,12 @@ class JointProblem {
         const Corners ph = hex_points(mesh_, hexes_[h]), pg = hex_points(mesh_, hexes_[g]);
         hex_scaled_jacobian_samples_pair(ph, pg, samples_[h], samples_[g]);
         // Past its edge-ratio cap a hex makes the point infeasible, like a non-finite sample.
-        constexpr double none = std::numeric_limits<double>::infinity();
-        if ((edge_caps_[h] != none && !(hex_edge_ratio(ph) <= edge_caps_[h])) ||
-            (edge_caps_[g] != none && !(hex_edge_ratio(pg) <= edge_caps_[g])))
-          m = -std::numeric_limits<double>::infinity();
-        if (options_.cap_samples) {
-          cap_samples_[h] = hex_cap_sample(ph, edge_caps_[h], hex_vars_[h]);
-          cap_samples_[g] = hex_cap_sample(pg, edge_caps_[g], hex_vars_[g]);
+        for (const auto& [k, pk] : {std::pair<int64_t, const Corners&>{h, ph}, {g, pg}}) {
+          if (!std::isfinite(edge_caps_[k])) continue;  // no cap: no test, no cap sample
+          const HexEdgeLengths lengths = hex_edge_lengths(pk);
+          if (!(lengths.ratio() <= edge_caps_[k])) m = -std::numeric_limits<double>::infinity();
+          if (options_.cap_samples)
+            cap_samples_[k] = hex_cap_sample(pk, lengths, edge_caps_[k], hex_vars_[k]);
         }
       }
       double cap_min = std::numeric_limits<double>::infinity();
@@ -428,7 +446,8 @@ class JointProblem {
           const Corners p = hex_points(mesh_, hexes_[h]);
           hex_samples(p, unused, &weights, &hex_gradient_[h]);
           if (cap_weight != 0)
-            hex_cap_sample(p, edge_caps_[h], hex_vars_[h], cap_weight, &hex_gradient_[h]);
+            hex_cap_sample(p, hex_edge_lengths(p), edge_caps_[h], hex_vars_[h], cap_weight,
+                           &hex_gradient_[h]);
         } else {
           for (Vec3& g : hex_gradient_[h]) g.setZero();
         }

@@ -181,6 +181,40 @@ TEST(Pipeline, PlacementFallbackMakesAFormerRefusalValid) {
             r.stats.placement_fallback_untangled);
 }
 
+// --smooth never ends below plain refine. ecr_cap.mesh surface:0, sheet: smoothed from the
+// untangle start the minimum ends at 0.2503, below the 0.2749 that the optimized placement gives
+// unsmoothed; the run is then placed by optimized and smoothed from there, and says so.
+TEST(Pipeline, SmoothingEndingBelowPlainRefineStartsAgainFromOptimized) {
+  const HexMesh input = mesh_read(shared_mesh("ecr_cap.mesh"));
+  PipelineOptions o;
+  o.method = "sheet";
+  o.select = {"surface:0"};
+  const double plain = pipeline_run(input, o).check.min_scaled_jacobian;
+  EXPECT_NEAR(plain, 0.274948, 1e-6);
+  o.smooth = true;
+  o.refine.placement.method = pipeline_default_placement(o.smooth);
+  o.smoothing_start_fallback = false;
+  const PipelineResult one = pipeline_run(input, o);
+  ASSERT_TRUE(one.smoothed_check);
+  EXPECT_NEAR(one.smoothed_check->min_scaled_jacobian, 0.250317, 1e-6);
+  EXPECT_FALSE(one.placement_used);
+  o.smoothing_start_fallback = true;
+  const PipelineResult r = pipeline_run(input, o);
+  ASSERT_TRUE(r.smoothed_check);
+  EXPECT_TRUE(r.smoothed_check->valid());
+  EXPECT_GE(r.smoothed_check->min_scaled_jacobian, plain);
+  ASSERT_TRUE(r.placement_used);
+  EXPECT_EQ(*r.placement_used, PlacementMethod::optimized);
+  EXPECT_NE(r.placement_warning.find("smoothing from untangle reached 0.250317"), std::string::npos)
+      << r.placement_warning;
+  EXPECT_EQ(r.stats.final_hexes, one.stats.final_hexes);
+  // Both starts' refinements and smoothings are billed.
+  EXPECT_GT(r.stage_cpu_seconds.at("smooth"), one.stage_cpu_seconds.at("smooth"));
+  const nlohmann::json j = pipeline_report(r, o);
+  EXPECT_EQ(j.at("options").at("placement").at("method"), "optimized");
+  EXPECT_EQ(j.at("refine").at("placement_warning"), r.placement_warning);
+}
+
 // Issue 28: --smooth never refuses a valid input for its start. On ecr_cap.mesh, two selective
 // passes under the layer rule, the thesis' positions (`untangle`, the start smoothing prefers)
 // leave a child of input hex 3733 that no untangling saves; the pipeline then places the

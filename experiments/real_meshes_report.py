@@ -81,6 +81,10 @@ def summarise(r):
          "input_min": r.get("input", {}).get("initial_min_scaled_jacobian")}
     if s["error"]:
         return s
+    # The runner stamps the case's options; where the pipeline placed by `optimized` instead of
+    # the untangle start (refused, or smoothed below plain refine), refine.placement_warning
+    # says so.
+    s["placement_warning"] = r.get("refine", {}).get("placement_warning")
     check = r["check"]
     parents = r["refined_parents"]
     s["parents"] = parents["min_scaled_jacobian"]
@@ -180,7 +184,8 @@ def targets_section(rows):
               (s["folder"], s["mesh"], s["kind"], s["method"]) in plain]
     below_plain = [s for s in paired if s["smoothed"] < plain[
         (s["folder"], s["mesh"], s["kind"], s["method"])] - EPS]
-    restarted = sum(1 for s in returned if s["placement"] == "optimized")
+    restarted = sum(1 for s in returned if (s.get("placement_warning") or "").startswith(
+        "smoothing from untangle"))
     row("`--smooth` never below plain refine (the default placement, unsmoothed, same targets)",
         "%d of %d (%d smoothed from optimized after untangle ended below it)%s" % (
             len(paired) - len(below_plain), len(paired), restarted,
@@ -254,7 +259,14 @@ def targets_section(rows):
             used[s["arm"]][s["placement"]] += 1
     out.append("\nPlacement each arm used (the records' `options.placement.method`): " + "; ".join(
         "*%s*: %s" % (arm, ", ".join("%s (%d runs)" % kv for kv in sorted(used[arm].items())))
-        for arm in ARMS if arm in used) + ". *Valid input*: the checker passes it (tag "
+        for arm in ARMS if arm in used) + "; of the *default-smooth* runs, %d were placed by "
+        "optimized instead of the untangle start (refused: %d; smoothed below plain refine: %d; "
+        "`refine.placement_warning`)" % tuple(
+            sum(1 for s in rows if s["arm"] == "default-smooth" and not s["error"] and cond(
+                s.get("placement_warning") or "")) for cond in (
+                lambda w: bool(w), lambda w: w.startswith("the untangle start was refused"),
+                lambda w: w.startswith("smoothing from untangle"))) +
+        ". *Valid input*: the checker passes it (tag "
         "`input_valid`); refusals of invalid inputs are the right answer and are not counted.")
     return out
 

@@ -157,10 +157,15 @@ double process_peak_memory_mb() {
 
 namespace {
 
+PipelineResult pipeline_run_both_starts(const HexMesh& input, const PipelineOptions& o,
+                                        const std::string& out);
+
 /// pipeline_run, and with a non-empty `out` the write of the final mesh there (see
 /// pipeline_run_files).
 PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions& o,
                                     const std::string& out) {
+  if (o.smooth && o.smoothing_both_starts && o.refine.placement.method == PlacementMethod::untangle)
+    return pipeline_run_both_starts(input, o, out);
   const auto start = Clock::now();
   PipelineResult r;
   StageClock clock(r, o.verbose, o.progress);
@@ -456,6 +461,55 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
   r.stage_seconds["total"] = seconds_since(start);
   r.peak_memory_mb = process_peak_memory_mb();
   return r;
+}
+
+/// PipelineOptions::smoothing_both_starts: both runs without a write, then the better one
+/// written (both passed their checks, or they would have thrown).
+PipelineResult pipeline_run_both_starts(const HexMesh& input, const PipelineOptions& o,
+                                        const std::string& out) {
+  const auto start = Clock::now();
+  PipelineOptions first = o;
+  first.smoothing_both_starts = false;
+  first.smoothing_start_fallback = false;  // the second start is the optimized one
+  PipelineResult kept = pipeline_run_writing(input, first, "");
+  PipelineOptions second = first;
+  second.refine.placement.method = PlacementMethod::optimized;
+  std::optional<PipelineResult> other;
+  try {
+    other = pipeline_run_writing(input, second, "");
+  } catch (const OperationError&) {
+    // optimized refused where untangle did not: the untangle start stands
+  }
+  auto final_min = [](const PipelineResult& r) {
+    return r.smoothed_check ? r.smoothed_check->min_scaled_jacobian : r.check.min_scaled_jacobian;
+  };
+  if (other) {
+    const double untangle_min = final_min(kept), optimized_min = final_min(*other);
+    if (optimized_min > untangle_min) {
+      std::swap(kept, *other);
+      kept.placement_used = PlacementMethod::optimized;
+      std::ostringstream why;
+      why << "smoothed from both starts: " << optimized_min << " from optimized, " << untangle_min
+          << " from untangle; kept optimized";
+      kept.placement_warning = why.str();
+    }
+    for (const auto& [stage, seconds] : other->stage_seconds) kept.stage_seconds[stage] += seconds;
+    for (const auto& [stage, seconds] : other->stage_cpu_seconds)
+      kept.stage_cpu_seconds[stage] += seconds;
+  }
+  if (!out.empty()) {
+    StagedMeshWrite staged(out, kept.mesh, o.write);
+    try {
+      staged.commit();
+    } catch (const InputError& e) {
+      throw OutputWriteError(e.what());  // names the output: no input prefix
+    }
+    kept.stage_seconds["write"] = staged.seconds();
+    kept.stage_cpu_seconds["write"] = staged.cpu_seconds();
+  }
+  kept.stage_seconds["total"] = seconds_since(start);
+  kept.peak_memory_mb = process_peak_memory_mb();
+  return kept;
 }
 
 }  // namespace

@@ -85,6 +85,14 @@ struct PipelineOptions {
   /// sheet, 0.2503 smoothed against 0.2749). The optimized placement is billed to the smooth stage.
   /// false: one start only (ablation, tests).
   bool smoothing_start_fallback = true;
+  /// `--smooth` from both starts (`refine --smooth-both-starts`): placed by `untangle` and
+  /// smoothed, placed by `optimized` and smoothed, and the one with the higher smoothed minimum
+  /// kept (the untangle one on a tie); both refinements and smoothings are billed, about twice
+  /// the time. Neither start is the better one on every case: over the real-mesh study's
+  /// smoothed cases below 0.5 x their parents the optimized start ends higher on 35 of 68,
+  /// lower on 19, and lifts 11 to 0.5 x (results/smoothing_starts.md). Only where the start is
+  /// `untangle` (the default with smoothing).
+  bool smoothing_both_starts = false;
   /// Refuse before refining when n * 27^passes could exceed this many output hexes (int32 ids).
   int64_t max_hexes = std::numeric_limits<int32_t>::max();
   MeshWriteOptions write;  ///< how pipeline_run_files writes the output

@@ -98,6 +98,13 @@ int refine_run(const CliArgs& a) {
        {"--smooth-sweeps", "--smooth-joint-iterations", "--smooth-joint-rounds"})
     if (a.value(option) && !o.smooth)
       throw InputError(std::string("hexrefine refine: ") + option + " needs --smooth");
+  o.smoothing_both_starts = a.flag("--smooth-both-starts");
+  if (o.smoothing_both_starts && !o.smooth)
+    throw InputError("hexrefine refine: --smooth-both-starts needs --smooth");
+  if (o.smoothing_both_starts && o.refine.placement.method != PlacementMethod::untangle)
+    throw InputError(
+        "hexrefine refine: --smooth-both-starts smooths from untangle and from optimized: it "
+        "takes no --placement but untangle");
   if (const auto n = a.value("--smooth-sweeps"))
     o.smoothing.max_sweeps =
         static_cast<int>(cli_parse_int_in(*n, 1, 1000000, "hexrefine refine: --smooth-sweeps"));
@@ -181,6 +188,9 @@ const CliCommand cli_refine_command = {
          "unless a placement is given, and from optimized where untangle ends below plain "
          "refine's minimum, with a warning; a smoothing the checker rejects is undone, with a "
          "warning in the report)"},
+        {"--smooth-both-starts", "",
+         "--smooth: place by untangle and by optimized, smooth both, keep the higher minimum "
+         "(about twice the time; results/smoothing_starts.md)"},
         {"--smooth-sweeps", "N",
          "--smooth: at most N sweeps over the region's nodes before the joint ascent and N after "
          "each of its rounds, 1..1000000 (default 20; fewer: faster, lower minimum)"},

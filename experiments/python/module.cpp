@@ -237,7 +237,7 @@ PYBIND11_MODULE(_hexrefine, m) {
          bool propagation, bool ebe_only, const std::string& placement, int threads,
          bool allow_inverted, int64_t max_hexes, double max_edge_ratio,
          std::optional<int> smooth_sweeps, std::optional<int> smooth_joint_iterations,
-         std::optional<int> smooth_joint_rounds) {
+         std::optional<int> smooth_joint_rounds, bool smooth_both_starts) {
         PipelineOptions o;
         o.method = method;
         if (py::isinstance<py::str>(targets) || py::isinstance<py::list>(targets) ||
@@ -319,6 +319,13 @@ PYBIND11_MODULE(_hexrefine, m) {
         if (smooth_sweeps) o.smoothing.max_sweeps = *smooth_sweeps;
         if (smooth_joint_rounds) o.smoothing.joint_rounds = *smooth_joint_rounds;
         if (smooth_joint_iterations) o.smoothing.joint_iterations = *smooth_joint_iterations;
+        // As the CLI's --smooth-both-starts.
+        if (smooth_both_starts && !smooth) throw InputError("smooth_both_starts needs smooth=True");
+        if (smooth_both_starts && o.refine.placement.method != PlacementMethod::untangle)
+          throw InputError(
+              "smooth_both_starts smooths from untangle and from optimized: it takes no "
+              "placement but 'untangle'");
+        o.smoothing_both_starts = smooth_both_starts;
         o.max_hexes = max_hexes;
         PipelineResult r;
         {
@@ -332,7 +339,7 @@ PYBIND11_MODULE(_hexrefine, m) {
       "propagation"_a = true, "ebe_only"_a = false, "placement"_a = "", "threads"_a = 1,
       "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647}, "max_edge_ratio"_a = 20.0,
       "smooth_sweeps"_a = py::none(), "smooth_joint_iterations"_a = py::none(),
-      "smooth_joint_rounds"_a = py::none(),
+      "smooth_joint_rounds"_a = py::none(), "smooth_both_starts"_a = false,
       "Refines `targets` (hex ids, or selection specs) by `method` through the pipeline: plan, "
       "apply, place the new nodes (placement 'optimized', the thesis' 'trilinear', 'reference': "
       "the templates' reference positions, or 'untangle': trilinear with inverted children "
@@ -346,7 +353,9 @@ PYBIND11_MODULE(_hexrefine, m) {
       "placement and smoothing give no hex an edge ratio above it or its ratio before (0: no "
       "cap). `smooth_sweeps`, `smooth_joint_iterations`, `smooth_joint_rounds` (smooth=True "
       "only; None: 20, 100 and 3): the smoothing's budget (refine --smooth-sweeps, "
-      "--smooth-joint-iterations, --smooth-joint-rounds). "
+      "--smooth-joint-iterations, --smooth-joint-rounds). `smooth_both_starts` (smooth=True, "
+      "no placement but 'untangle'): smooth from untangle and from optimized, keep the higher "
+      "minimum (refine --smooth-both-starts). "
       "RefinementError if the method "
       "refuses or the result "
       "is invalid (unless an ablation switch or allow_inverted); ValueError for bad input.");

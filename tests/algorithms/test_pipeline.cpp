@@ -215,6 +215,46 @@ TEST(Pipeline, SmoothingEndingBelowPlainRefineStartsAgainFromOptimized) {
   EXPECT_EQ(j.at("refine").at("placement_warning"), r.placement_warning);
 }
 
+// --smooth-both-starts keeps the better of the two smoothings. ecr_cap.mesh surface:0: with the
+// sheet method the optimized start ends higher (0.2749 against untangle's 0.2503), with the
+// selective one the untangle start does (results/smoothing_starts.md); both runs are billed.
+TEST(Pipeline, SmoothingFromBothStartsKeepsTheHigherMinimum) {
+  const HexMesh input = mesh_read(shared_mesh("ecr_cap.mesh"));
+  PipelineOptions o;
+  o.select = {"surface:0"};
+  o.smooth = true;
+  o.refine.placement.method = pipeline_default_placement(o.smooth);
+  for (const char* method : {"sheet", "selective"}) {
+    SCOPED_TRACE(method);
+    o.method = method;
+    o.smoothing_both_starts = false;
+    o.smoothing_start_fallback = false;
+    const PipelineResult untangle = pipeline_run(input, o);
+    PipelineOptions optimized_options = o;
+    optimized_options.refine.placement.method = PlacementMethod::optimized;
+    const PipelineResult optimized = pipeline_run(input, optimized_options);
+    o.smoothing_start_fallback = true;
+    o.smoothing_both_starts = true;
+    const PipelineResult both = pipeline_run(input, o);
+    ASSERT_TRUE(untangle.smoothed_check && optimized.smoothed_check && both.smoothed_check);
+    const double u = untangle.smoothed_check->min_scaled_jacobian;
+    const double p = optimized.smoothed_check->min_scaled_jacobian;
+    EXPECT_EQ(both.smoothed_check->min_scaled_jacobian, std::max(u, p));
+    EXPECT_TRUE(both.smoothed_check->valid());
+    EXPECT_EQ(both.placement_used.has_value(), p > u);
+    EXPECT_EQ(both.placement_warning.find("smoothed from both starts") != std::string::npos, p > u)
+        << both.placement_warning;
+    EXPECT_EQ(both.mesh.points, (p > u ? optimized : untangle).mesh.points);
+    EXPECT_GE(both.stage_cpu_seconds.at("smooth"), untangle.stage_cpu_seconds.at("smooth"));
+    if (std::string(method) == "sheet") {
+      EXPECT_NEAR(u, 0.250317, 1e-6);
+      EXPECT_NEAR(p, 0.274948, 1e-6);
+    } else {
+      EXPECT_GT(u, p);
+    }
+  }
+}
+
 // Issue 28: --smooth never refuses a valid input for its start. On ecr_cap.mesh, two selective
 // passes under the layer rule, the thesis' positions (`untangle`, the start smoothing prefers)
 // leave a child of input hex 3733 that no untangling saves; the pipeline then places the

@@ -294,6 +294,18 @@ TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
   EXPECT_EQ(unsmoothed.exit_code, 2);
   EXPECT_NE(unsmoothed.output.find("--smooth-sweeps needs --smooth"), std::string::npos)
       << unsmoothed.output;
+  // --smooth-both-starts: only with --smooth, and it chooses the placements itself.
+  const std::string rocker = join(
+      {"refine", shared_mesh("rockerarm.mesh"), out, "--method selective --select sphere:0,0,0,5"});
+  const CliRun both_unsmoothed = cli_run(join({rocker, "--smooth-both-starts"}));
+  EXPECT_EQ(both_unsmoothed.exit_code, 2);
+  EXPECT_NE(both_unsmoothed.output.find("--smooth-both-starts needs --smooth"), std::string::npos)
+      << both_unsmoothed.output;
+  const CliRun both_placed =
+      cli_run(join({rocker, "--smooth --smooth-both-starts --placement optimized"}));
+  EXPECT_EQ(both_placed.exit_code, 2);
+  EXPECT_NE(both_placed.output.find("takes no --placement but untangle"), std::string::npos)
+      << both_placed.output;
 }
 
 }  // namespace

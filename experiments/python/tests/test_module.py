@@ -183,6 +183,16 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth_joint_rounds=2)
     with pytest.raises(ValueError, match="smooth_joint_rounds must be in 1..1000"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_joint_rounds=0)
+    # Both starts (refine --smooth-both-starts): never below the untangle start alone.
+    _, both = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=2,
+                               smooth_joint_iterations=0, smooth_both_starts=True)
+    assert both["smoothing"]["check"]["min_scaled_jacobian"] >= 0.1972858580749072
+    assert both["smoothing"]["check"]["valid"]
+    with pytest.raises(ValueError, match="smooth_both_starts needs smooth=True"):
+        hexrefine.refine(mesh, "sphere:0,0,0,5", smooth_both_starts=True)
+    with pytest.raises(ValueError, match="takes no placement but 'untangle'"):
+        hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, placement="optimized",
+                         smooth_both_starts=True)
 
 
 # --- errors --------------------------------------------------------------------------------------

@@ -8,7 +8,7 @@ optimized --smooth --threads 1`); the default's figure is the record's (the unta
 `optimized` where untangle ended below plain refine: `refine.placement_warning`). Per case: the
 smoothed minimum over the refined parents' minimum from each start and the better of the two, and
 the CPU seconds of refinement and smoothing. Writes OUT/smoothing_starts.json and
-OUT/smoothing_starts.md. About ten minutes on the 2-core machine.
+OUT/smoothing_starts.md. About fifteen minutes on the 2-core machine.
 
     python3 experiments/smoothing_starts.py [--records results/real_meshes.jsonl]
         [--meshes DIR ...] [--out results] [--hexrefine build/experiments/hexrefine]

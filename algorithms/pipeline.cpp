@@ -333,18 +333,26 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
       RefineOptions optimized = o.refine;
       optimized.placement.method = PlacementMethod::optimized;
       try {
-        const RefineResult plain = refine(method, input, Targets{r.selected}, optimized);
-        const std::vector<double> q = mesh_scaled_jacobians(plain.mesh);
-        optimized_min = *std::min_element(q.begin(), q.end());
+        optimized_min =
+            mesh_min_scaled_jacobian(refine(method, input, Targets{r.selected}, optimized).mesh);
       } catch (const PlacementError&) {
         // optimized refuses: nothing to fall back on
       }
     }
     clock.end("smooth");
+    std::optional<PipelineResult> restarted;
     if (r.smoothing->min_scaled_jacobian_after < optimized_min) {
       PipelineOptions again = o;
       again.refine.placement.method = PlacementMethod::optimized;
-      PipelineResult b = pipeline_run_writing(input, again, out);
+      try {
+        restarted = pipeline_run_writing(input, again, out);
+      } catch (const OperationError&) {
+        // The optimized refinement failed a check the untangle one passed (nothing was
+        // written): the untangle start stands.
+      }
+    }
+    if (restarted) {
+      PipelineResult& b = *restarted;
       b.placement_used = PlacementMethod::optimized;
       std::ostringstream why;
       why << "smoothing from untangle reached " << r.smoothing->min_scaled_jacobian_after
@@ -356,7 +364,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
       for (const auto& [stage, seconds] : r.stage_cpu_seconds)
         b.stage_cpu_seconds[stage] += seconds;
       b.stage_seconds["total"] = seconds_since(start);
-      return b;
+      return std::move(b);
     }
     clock.begin("check (smoothed)");
     r.smoothed_check.emplace();
@@ -475,11 +483,14 @@ PipelineResult pipeline_run_both_starts(const HexMesh& input, const PipelineOpti
   PipelineOptions second = first;
   second.refine.placement.method = PlacementMethod::optimized;
   std::optional<PipelineResult> other;
-  try {
-    other = pipeline_run_writing(input, second, "");
-  } catch (const OperationError&) {
-    // optimized refused where untangle did not: the untangle start stands
-  }
+  // Where the untangle start was refused the first run was placed by optimized already.
+  if (!kept.placement_used) try {
+      other = pipeline_run_writing(input, second, "");
+    } catch (const OperationError& e) {
+      // optimized refused where untangle did not: the untangle start stands
+      kept.placement_warning =
+          std::string("the optimized start failed (") + e.what() + "); kept the untangle start";
+    }
   auto final_min = [](const PipelineResult& r) {
     return r.smoothed_check ? r.smoothed_check->min_scaled_jacobian : r.check.min_scaled_jacobian;
   };
@@ -570,7 +581,8 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
                       {"nodes_undone", r.smoothing_nodes_undone},
                       {"max_sweeps", o.smoothing.max_sweeps},
                       {"max_joint_iterations", o.smoothing.joint_iterations},
-                      {"max_joint_rounds", o.smoothing.joint_rounds}};
+                      {"max_joint_rounds", o.smoothing.joint_rounds},
+                      {"both_starts", o.smoothing_both_starts}};
     if (!r.smoothing_warning.empty()) j["smoothing"]["warning"] = r.smoothing_warning;
   }
   j["stage_seconds"] = r.stage_seconds;

@@ -7,6 +7,7 @@
 
 #include "mesh/generators.hpp"
 #include "mesh/io.hpp"
+#include "mesh/quality.hpp"
 #include "tests/cli_runner.hpp"
 #include "tests/fixtures.hpp"
 
@@ -294,6 +295,29 @@ TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
   EXPECT_EQ(unsmoothed.exit_code, 2);
   EXPECT_NE(unsmoothed.output.find("--smooth-sweeps needs --smooth"), std::string::npos)
       << unsmoothed.output;
+  // The restart from optimized (the smoothing from untangle ended below plain refine) and both
+  // starts write their output once, checked, and report the start kept (ecr_cap surface:0,
+  // sheet: 0.2749 from optimized, 0.2503 from untangle).
+  for (const char* both : {"", "--smooth-both-starts"}) {
+    SCOPED_TRACE(both);
+    const std::string cap_out = (dir / "cap.vtu").string(),
+                      cap_report = (dir / "cap.json").string();
+    std::filesystem::remove(cap_out);
+    const CliRun run =
+        cli_run(join({"refine", shared_mesh("ecr_cap.mesh"), cap_out,
+                      "--method sheet --select surface:0 --smooth --report", cap_report, both}));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("warning: smooth"), std::string::npos) << run.output;
+    const nlohmann::json j = read_json(cap_report);
+    EXPECT_EQ(j.at("options").at("placement").at("method"), "optimized");
+    EXPECT_EQ(j.at("smoothing").at("both_starts").get<bool>(), std::string(both) != "");
+    EXPECT_NEAR(j.at("smoothing").at("check").at("min_scaled_jacobian").get<double>(), 0.274948,
+                1e-6);
+    EXPECT_GT(j.at("stage_seconds").at("write").get<double>(), 0);
+    const HexMesh written = mesh_read(cap_out);
+    EXPECT_EQ(written.hex_count(), j.at("smoothing").at("check").at("hexes").get<int64_t>());
+    EXPECT_NEAR(mesh_min_scaled_jacobian(written), 0.274948, 1e-6);
+  }
   // --smooth-both-starts: only with --smooth, and it chooses the placements itself.
   const std::string rocker = join(
       {"refine", shared_mesh("rockerarm.mesh"), out, "--method selective --select sphere:0,0,0,5"});

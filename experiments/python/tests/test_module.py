@@ -183,10 +183,20 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth_joint_rounds=2)
     with pytest.raises(ValueError, match="smooth_joint_rounds must be in 1..1000"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_joint_rounds=0)
-    # Both starts (refine --smooth-both-starts): never below the untangle start alone.
+    # Both starts (refine --smooth-both-starts): the higher of the untangle start (the budget run
+    # above) and the optimized one, and the report names the start kept.
+    _, optimized = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, placement="optimized",
+                                    smooth_sweeps=2, smooth_joint_iterations=0)
     _, both = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=2,
                                smooth_joint_iterations=0, smooth_both_starts=True)
-    assert both["smoothing"]["check"]["min_scaled_jacobian"] >= 0.1972858580749072
+    from_optimized = optimized["smoothing"]["check"]["min_scaled_jacobian"]
+    assert from_optimized != 0.1972858580749072
+    assert both["smoothing"]["check"]["min_scaled_jacobian"] == max(0.1972858580749072,
+                                                                    from_optimized)
+    kept = "optimized" if from_optimized > 0.1972858580749072 else "untangle"
+    assert both["options"]["placement"]["method"] == kept
+    assert ("smoothed from both starts" in both["refine"].get("placement_warning", "")) == (
+        kept == "optimized")
     assert both["smoothing"]["check"]["valid"]
     with pytest.raises(ValueError, match="smooth_both_starts needs smooth=True"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth_both_starts=True)

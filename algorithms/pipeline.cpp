@@ -161,9 +161,10 @@ PipelineResult pipeline_run_both_starts(const HexMesh& input, const PipelineOpti
                                         const std::string& out);
 
 /// pipeline_run, and with a non-empty `out` the write of the final mesh there (see
-/// pipeline_run_files).
+/// pipeline_run_files). `placed`, optional: the refinement of the selected targets by o.refine,
+/// already done (the restart from optimized reuses the one it compared with).
 PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions& o,
-                                    const std::string& out) {
+                                    const std::string& out, RefineResult* placed = nullptr) {
   if (o.smooth && o.smoothing_both_starts && o.refine.placement.method == PlacementMethod::untangle)
     return pipeline_run_both_starts(input, o, out);
   const auto start = Clock::now();
@@ -196,7 +197,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
   } else {
     RefineResult refined;
     try {
-      refined = refine(method, input, Targets{r.selected}, o.refine);
+      refined = placed ? std::move(*placed) : refine(method, input, Targets{r.selected}, o.refine);
     } catch (const PlacementError& e) {
       // `untangle` keeps the thesis' positions, the better start for smoothing, but on a
       // distorted input they can leave a child no untangling saves (ecr_cap.mesh, two passes:
@@ -328,13 +329,14 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     // The start's guarantee (PipelineOptions::smoothing_start_fallback): the minimum plain
     // `refine` reaches, placed by `optimized`.
     double optimized_min = -std::numeric_limits<double>::infinity();
+    PipelineOptions again = o;
+    again.refine.placement.method = PlacementMethod::optimized;
+    std::optional<RefineResult> plain;
     if (o.smoothing_start_fallback && o.refine.placement.method == PlacementMethod::untangle &&
         !r.placement_used) {
-      RefineOptions optimized = o.refine;
-      optimized.placement.method = PlacementMethod::optimized;
       try {
-        optimized_min =
-            mesh_min_scaled_jacobian(refine(method, input, Targets{r.selected}, optimized).mesh);
+        plain = refine(method, input, Targets{r.selected}, again.refine);
+        optimized_min = mesh_min_scaled_jacobian(plain->mesh);
       } catch (const PlacementError&) {
         // optimized refuses: nothing to fall back on
       }
@@ -342,10 +344,9 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
     clock.end("smooth");
     std::optional<PipelineResult> restarted;
     if (r.smoothing->min_scaled_jacobian_after < optimized_min) {
-      PipelineOptions again = o;
-      again.refine.placement.method = PlacementMethod::optimized;
       try {
-        restarted = pipeline_run_writing(input, again, out);
+        // The restart takes the optimized refinement just made instead of refining again.
+        restarted = pipeline_run_writing(input, again, out, &*plain);
       } catch (const OperationError&) {
         // The optimized refinement failed a check the untangle one passed (nothing was
         // written): the untangle start stands.
@@ -366,6 +367,7 @@ PipelineResult pipeline_run_writing(const HexMesh& input, const PipelineOptions&
       b.stage_seconds["total"] = seconds_since(start);
       return std::move(b);
     }
+    plain.reset();  // not needed past the comparison
     clock.begin("check (smoothed)");
     r.smoothed_check.emplace();
     r.smoothed_children_min_scaled_jacobian.emplace();

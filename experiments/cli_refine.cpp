@@ -196,7 +196,7 @@ const CliCommand cli_refine_command = {
          "each of its rounds, 1..1000000 (default 20; fewer: faster, lower minimum)"},
         {"--smooth-joint-iterations", "N",
          "--smooth: at most N iterations per round of the joint ascent of the nodes around the "
-         "worst hexes (boundary nodes on the surface), 0..1000000 (default 100; 0: the sweeps "
+         "worst hexes (boundary nodes on the surface), 0..1000000 (default 1000; 0: the sweeps "
          "alone)"},
         {"--smooth-joint-rounds", "N",
          "--smooth: at most N rounds of joint ascent and sweeps, each with a sharper soft "

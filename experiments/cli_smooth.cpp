@@ -127,7 +127,7 @@ const CliCommand cli_smooth_command = {
          "after each round of it)"},
         {"--joint-iterations", "N",
          "optimize: at most N iterations per round of the joint ascent of the nodes around the "
-         "worst hexes after the sweeps (boundary nodes on the surface), 0..1000000 (default 100; "
+         "worst hexes after the sweeps (boundary nodes on the surface), 0..1000000 (default 1000; "
          "0: the sweeps alone)"},
         {"--joint-rounds", "N",
          "optimize: at most N rounds of joint ascent and sweeps while a round raises the "

@@ -6,7 +6,7 @@ thread, on inputs of rockerarm size or larger).
 Every smoothed case of the real-mesh study (`results/real_meshes.jsonl`, arm `default-smooth`) on
 an input of at least 5,000 hexes is run again with `hexrefine refine ... --smooth --threads 1`
 under each budget (`--smooth-sweeps S --smooth-joint-iterations J --smooth-joint-rounds R`; the
-default is 20, 100 and 3),
+default is 20, 1000 and 3; 20, 100 and 3 before results/smoothing_budget_all.md),
 and the refine and smooth stages' CPU seconds and the smoothed children's minimum are taken from
 the report. Writes OUT/smoothing_budget.json (every run) and OUT/smoothing_budget.md (a row per
 budget: cases meeting each target, median and worst ratios). About ten minutes on the 2-core
@@ -35,14 +35,14 @@ MIN_INPUT_HEXES = 5000  # "rockerarm size": rockerarm has 10,600; real_meshes_re
 EPS = 1e-12
 
 
-def study_cases(records, folders):
+def study_cases(records, folders, min_input_hexes=MIN_INPUT_HEXES):
     cases = []
     for r in records:
         if r.get("tags", {}).get("arm") != "default-smooth" or r.get("error"):
             continue
         if "smoothing" not in r or "file" not in r.get("input", {}):
             continue
-        if r["input"]["hexes"] < MIN_INPUT_HEXES:
+        if r["input"]["hexes"] < min_input_hexes:
             continue
         path = find_mesh(r, folders)
         cases.append({"record": r, "path": str(path) if path else None,
@@ -50,7 +50,7 @@ def study_cases(records, folders):
     return cases
 
 
-DEFAULT_BUDGET = (20, 100, 3)
+DEFAULT_BUDGET = (20, 1000, 3)
 
 
 def run(hexrefine, case, sweeps, joint, rounds, tmp):
@@ -113,16 +113,19 @@ def write_report(result, out_dir):
     md = ["# The smoothing's budget: quality against time",
           "",
           "From `experiments/smoothing_budget.py` (`smoothing_budget.json`), %s, commit `%s`: "
-          "every smoothed case of `real_meshes.jsonl` on an input of at least %d hexes (%d cases, "
+          "every smoothed case of `real_meshes.jsonl` %s (%d cases, "
           "%d meshes), run again with `hexrefine refine ... --smooth --smooth-sweeps S "
           "--smooth-joint-iterations J --smooth-joint-rounds R --threads 1` per budget; CPU seconds of the refine and "
           "smooth stages from the report; quality is the smoothed children's minimum scaled "
           "Jacobian over the refined parents' minimum (the children alone: untouched input hexes "
           "left out, as in the children-only row of real_meshes.md). %d runs failed, %d cases "
           "skipped (mesh not at hand)." % (
-              result["date"][:10], result["commit"][:10], MIN_INPUT_HEXES, result["cases"],
+              result["date"][:10], result["commit"][:10],
+              "on an input of at least %d hexes" % result.get("min_input_hexes", MIN_INPUT_HEXES)
+              if result.get("min_input_hexes", MIN_INPUT_HEXES) > 0 else "with refined parents",
+              result["cases"],
               len({r["mesh"] for r in runs}), len(errors), len(result.get("skipped", []))),
-          ""] + budget_rows(runs) + [""]
+          ""] + ([result["note"], ""] if result.get("note") else []) + budget_rows(runs) + [""]
     if one:
         md.append("One sweep and no joint ascent (each node whose worst hex is below 0.5 "
                   "optimized once over the hexes around it) still takes more than 5 x the "
@@ -147,13 +150,17 @@ def main():
     ap.add_argument("--budgets", nargs="+",
                     default=["20,100,3", "20,100,1", "6,30,1", "3,0,1", "1,0,1"],
                     help="S,J[,R]: sweeps, joint iterations, joint rounds (R default 3)")
+    ap.add_argument("--min-input-hexes", type=int, default=MIN_INPUT_HEXES,
+                    help="the cases on inputs of at least this many hexes (default %d, rockerarm "
+                    "size: the time target's cases; 0: every smoothed case)" % MIN_INPUT_HEXES)
     args = ap.parse_args()
     out_dir = pathlib.Path(args.out)
     if args.report_only:
         write_report(json.loads((out_dir / "smoothing_budget.json").read_text()), out_dir)
         return
     folders = mesh_folders(args)
-    cases = study_cases([json.loads(line) for line in open(args.records)], folders)
+    cases = study_cases([json.loads(line) for line in open(args.records)], folders,
+                        args.min_input_hexes)
     budgets = [tuple(int(x) for x in (b + ",3" if b.count(",") == 1 else b).split(","))
                for b in args.budgets]
     runs, skipped = [], []
@@ -170,7 +177,7 @@ def main():
                             text=True).stdout.strip()
     result = {"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
               "commit": commit, "records": args.records, "mesh_folders": folders,
-              "cases": len(cases), "budgets": [list(b) for b in budgets], "runs": runs,
+              "cases": len(cases), "min_input_hexes": args.min_input_hexes, "budgets": [list(b) for b in budgets], "runs": runs,
               "skipped": skipped}
     if skipped:
         print("%d cases skipped: mesh not in %s" % (len(skipped), ", ".join(folders)),

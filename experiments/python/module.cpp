@@ -352,7 +352,7 @@ PYBIND11_MODULE(_hexrefine, m) {
       "smoothing and the check (the same mesh for any count). `max_edge_ratio`: optimized "
       "placement and smoothing give no hex an edge ratio above it or its ratio before (0: no "
       "cap). `smooth_sweeps`, `smooth_joint_iterations`, `smooth_joint_rounds` (smooth=True "
-      "only; None: 20, 100 and 3): the smoothing's budget (refine --smooth-sweeps, "
+      "only; None: 20, 1000 and 3): the smoothing's budget (refine --smooth-sweeps, "
       "--smooth-joint-iterations, --smooth-joint-rounds). `smooth_both_starts` (smooth=True, "
       "no placement but 'untangle'): smooth from untangle and from optimized, keep the higher "
       "minimum (refine --smooth-both-starts). "

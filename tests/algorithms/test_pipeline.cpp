@@ -108,6 +108,7 @@ TEST(Pipeline, SmoothingTheCheckerRejectsIsUndoneNotAnError) {
   PipelineOptions o;
   o.select = {"random:0.02,1"};
   o.smooth = true;
+  o.smoothing.joint_iterations = 100;  // the budget the rejected faces were counted at
   o.refine.placement.method = pipeline_default_placement(o.smooth);
   const PipelineResult at_creases = pipeline_run(input, o);
   ASSERT_TRUE(at_creases.smoothed_check);

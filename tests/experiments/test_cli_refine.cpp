@@ -263,8 +263,8 @@ TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
     double smoothed;
   };
   for (const Case& c :
-       {Case{"", 20, 100, 3, 0.5248719182924853},
-        Case{"--smooth-joint-rounds 1", 20, 100, 1, 0.4893584069476542},
+       {Case{"", 20, 1000, 3, 0.5457535571145382},
+        Case{"--smooth-joint-rounds 1", 20, 1000, 1, 0.5003094177402794},
         Case{"--smooth-sweeps 2 --smooth-joint-iterations 0", 2, 0, 3, 0.1972858580749072}}) {
     SCOPED_TRACE(c.flags);
     const CliRun r = cli_run(join({base, c.flags}));

@@ -217,11 +217,12 @@ TEST(NodePlacement, FormerRefusalsAreValidAtTheReferencePositions) {
 
 TEST(NodePlacement, UntangleStartsFromTheThesisPositionsTheBetterStartForSmoothing) {
   // rockerarm sphere:0,0,0,5: every child at the reference positions is valid (minimum 0.0879),
-  // but smoothing from there ends at 0.5175, below smoothing from the thesis' positions
-  // untangled (0.5249; before the joint ascent slid boundary nodes and ran in rounds, 0.3665
-  // against 0.4587): the reference positions have spent the edge-ratio room in the long
-  // parents (largest edge ratio 19.4 against 14.9). So `untangle`, the start of --smooth, keeps
-  // the thesis' positions.
+  // but smoothing from there with 100 joint iterations per round ends at 0.5175, below smoothing
+  // from the thesis' positions untangled (0.5249; before the joint ascent slid boundary nodes
+  // and ran in rounds, 0.3665 against 0.4587): the reference positions have spent the
+  // edge-ratio room in the long parents (largest edge ratio 19.4 against 14.9). So `untangle`,
+  // the start of --smooth, keeps the thesis' positions. With the default budget (1000 per
+  // round) both starts end at the same minimum, 0.5458.
   const HexMesh m = mesh_read(shared_mesh("rockerarm.mesh"));
   PipelineOptions o;
   o.method = "selective";
@@ -238,7 +239,11 @@ TEST(NodePlacement, UntangleStartsFromTheThesisPositionsTheBetterStartForSmoothi
   const PipelineResult smoothed = pipeline_run(m, o);
   ASSERT_TRUE(smoothed.smoothed_check);
   EXPECT_TRUE(smoothed.smoothed_check->valid());
-  EXPECT_NEAR(smoothed.smoothed_check->min_scaled_jacobian, 0.5248719, 1e-6);
+  EXPECT_NEAR(smoothed.smoothed_check->min_scaled_jacobian, 0.5457536, 1e-6);
+  o.smoothing.joint_iterations = 100;
+  const PipelineResult smoothed_short = pipeline_run(m, o);
+  ASSERT_TRUE(smoothed_short.smoothed_check);
+  EXPECT_NEAR(smoothed_short.smoothed_check->min_scaled_jacobian, 0.5248719, 1e-6);
   o.refine.placement.method = PlacementMethod::reference;
   const PipelineResult from_reference = pipeline_run(m, o);
   ASSERT_TRUE(from_reference.smoothed_check);

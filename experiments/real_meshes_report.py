@@ -17,6 +17,7 @@ pipeline picks the default's). The input counts as valid when the checker passed
 """
 
 import argparse
+import collections
 import json
 import os
 
@@ -443,6 +444,19 @@ def quality_plot(rows, path):
     os.replace(path + ".tmp.png", path)
 
 
+def study_commits(study):
+    """The commits the records were run at, with their counts where there are several (a
+    `--resume` rerun of some cases)."""
+    counts = collections.Counter((r.get("commit", "?")[:12], bool(r.get("commit_dirty")))
+                                 for r in study)
+    names = ["%s%s" % (c, " with uncommitted changes" if dirty else "") for c, dirty in counts]
+    if len(counts) == 1:
+        return names[0]
+    order = sorted(counts, key=lambda k: -counts[k])
+    return ", ".join("%s: %d records" % ("%s%s" % (c, " with uncommitted changes" if d else ""),
+                                        counts[(c, d)]) for c, d in order)
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("records")
@@ -470,7 +484,7 @@ def main():
            "*default-smooth* (no placement given, `--smooth`), each a run of its own, each "
            "output checked against its input. Quality is the scaled Jacobian; *parents* is the "
            "minimum over the input hexes that were refined.%s\n" % (
-               os.path.basename(args.records), len(study), study[0].get("commit", "?")[:12],
+               os.path.basename(args.records), len(study), study_commits(study),
                (" Left out: " + left_out + ".") if left_out else "")]
     out += targets_section(rows)
     out += refusals_section(rows)

@@ -85,7 +85,10 @@ std::vector<int32_t> placement_fallback_untangle(HexMesh& refined,
     if (!(before[h] > 0)) inverted.push_back(h);
   // Validity first: the sweeps visit every node of the region (visit_below 1) and, if the
   // edge-ratio cap holds a child inverted, run again without it over a wider region (an inverted
-  // child has no quality to protect; a collapsed edge shows in the report's max_edge_ratio).
+  // child has no quality to protect; a stretched edge shows in the report's max_edge_ratio). That
+  // second run has no joint ascent: without the cap the ascent raises the scaled Jacobian by
+  // collapsing edges (ecr_cap.mesh ball, untangle: largest edge ratio 3.3e8 with it, 183 without),
+  // and every later stage caps a hex at its ratio from here.
   SmoothOptions smoothing;
   smoothing.region_hexes = inverted;
   smoothing.layers = 2;
@@ -100,6 +103,7 @@ std::vector<int32_t> placement_fallback_untangle(HexMesh& refined,
       })) {
     smoothing.layers = 4;
     smoothing.max_edge_ratio = 0;
+    smoothing.joint_iterations = 0;
     mesh_smooth(refined, smoothing);
   }
   const std::vector<double> after = mesh_scaled_jacobians(refined);

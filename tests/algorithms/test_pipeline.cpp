@@ -178,6 +178,11 @@ TEST(Pipeline, PlacementFallbackMakesAFormerRefusalValid) {
   EXPECT_EQ(r.check.inverted_hexes, 0);
   EXPECT_EQ(r.stats.placement_fallback_untangled, 5);
   EXPECT_EQ(r.stats.final_hexes, 26080);
+  // The fallback's second smoothing, without the edge-ratio cap, is for validity alone: with the
+  // joint ascent it bought scaled Jacobian by collapsing an edge (largest edge ratio 36,356 at
+  // 100 joint iterations, 3.3e8 at 1000), which the smoothing after it, capped at each hex's
+  // ratio before, then kept.
+  EXPECT_NEAR(r.check.max_edge_ratio, 182.658, 1e-3);
   EXPECT_EQ(pipeline_report(r, o).at("refine").at("placement_fallback_untangled"),
             r.stats.placement_fallback_untangled);
 }

@@ -61,6 +61,7 @@ def run(hexrefine, case, sweeps, joint, rounds, tmp):
         "--smooth-joint-rounds", str(rounds), "--report", str(report)]
     p = subprocess.run(argv, capture_output=True, text=True)
     row = {"case": r["case"], "method": r["method"], "mesh": case["mesh"],
+           "input_hexes": r["input"]["hexes"],
            "sweeps": sweeps, "joint_iterations": joint, "joint_rounds": rounds}
     if p.returncode != 0:
         row["error"] = (p.stdout + p.stderr)[-500:]
@@ -126,6 +127,10 @@ def write_report(result, out_dir):
               result["cases"],
               len({r["mesh"] for r in runs}), len(errors), len(result.get("skipped", []))),
           ""] + ([result["note"], ""] if result.get("note") else []) + budget_rows(runs) + [""]
+    large = [r for r in runs if r.get("input_hexes", 0) >= MIN_INPUT_HEXES]
+    if result.get("min_input_hexes", MIN_INPUT_HEXES) < MIN_INPUT_HEXES and large:
+        md += ["The cases on inputs of at least %d hexes (rockerarm size, the time target's):" %
+               MIN_INPUT_HEXES, ""] + budget_rows(large) + [""]
     if one:
         md.append("One sweep and no joint ascent (each node whose worst hex is below 0.5 "
                   "optimized once over the hexes around it) still takes more than 5 x the "

@@ -161,7 +161,10 @@ def main():
             case["children_min"] = children_min(refine_report)
             # The same run without the edge-ratio cap: where the smoothed children then reach
             # more, the cap (issue 28, decision 1) is what holds them.
-            uncapped = subprocess.run(without_cap(argv) + ["--report", str(refine_report)],
+            # (to a file of its own: `out` is the capped output the check below lists)
+            uncapped_argv = without_cap(argv)
+            uncapped_argv[uncapped_argv.index(str(out))] = str(pathlib.Path(tmp) / "uncapped.vtu")
+            uncapped = subprocess.run(uncapped_argv + ["--report", str(refine_report)],
                                       capture_output=True, text=True)
             if uncapped.returncode == 0:
                 case["uncapped_children_min"] = children_min(refine_report)

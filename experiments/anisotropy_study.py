@@ -282,8 +282,9 @@ def write_report(result, out_dir):
                                            between[2], total[2]), "",
                "Not at or above the brick's figure: %d; of these, %d reach 0.5 x the parents when "
                "the same case runs without the edge-ratio cap (*no cap*: the smoothed children's "
-               "minimum over the parents' with `--max-edge-ratio 0`, from worst_hexes.json), so "
-               "the cap of issue 28's decision 1 is what holds them: %s." % (
+               "minimum over the parents' with `--max-edge-ratio 0`, from worst_hexes.json; a run "
+               "on another path, placement uncapped too, so a pointer, not a bound), which points "
+               "at the cap of issue 28's decision 1: %s." % (
                    len(unexplained), len(cap_held),
                    ", ".join("%s %s %s" % (m["mesh"], m["kind"], m["method"]) for m in cap_held)
                    or "none"), "",
@@ -302,8 +303,9 @@ def main():
     ap.add_argument("--hexrefine", default=str(REPO / "build" / "experiments" / "hexrefine"))
     ap.add_argument("--report-only", action="store_true")
     ap.add_argument("--bricks", default=None,
-                    help="an anisotropy.json whose brick runs to keep (with --worst: only the "
-                    "misses run again; the bricks do not depend on the study)")
+                    help="an anisotropy.json whose brick runs (and their commit and date) to keep, "
+                    "the bricks not being run again: they do not depend on the study (with "
+                    "--worst: the misses are set against them anew)")
     args = ap.parse_args()
     out_dir = pathlib.Path(args.out)
     if args.report_only:
@@ -311,14 +313,18 @@ def main():
         return
     commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "HEAD"], capture_output=True,
                             text=True).stdout.strip()
+    bricks_date = None
     if args.bricks:
         kept = json.loads(pathlib.Path(args.bricks).read_text())
-        runs, commit = kept["runs"], kept["commit"]
+        if kept.get("bricks") != {"n": N, "aspects": ASPECTS}:
+            sys.exit("%s: its bricks are not this script's (n %d, aspects %s)" % (
+                args.bricks, N, ASPECTS))
+        runs, commit, bricks_date = kept["runs"], kept["commit"], kept["date"]
     else:
         with tempfile.TemporaryDirectory() as tmp:
             runs = brick_runs(args.hexrefine, tmp)
-    result = {"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-              "commit": commit, "bricks": {"n": N, "aspects": ASPECTS}, "runs": runs}
+    result = {"date": bricks_date or datetime.datetime.now(datetime.timezone.utc).isoformat(
+        timespec="seconds"), "commit": commit, "bricks": {"n": N, "aspects": ASPECTS}, "runs": runs}
     if args.worst:
         folders = args.meshes or [str(REPO.parent / "shared" / "meshes")]
         result["misses"] = miss_rows(args.worst, folders)

@@ -6,14 +6,15 @@ thread, on inputs of rockerarm size or larger).
 Every smoothed case of the real-mesh study (`results/real_meshes.jsonl`, arm `default-smooth`) on
 an input of at least 5,000 hexes is run again with `hexrefine refine ... --smooth --threads 1`
 under each budget (`--smooth-sweeps S --smooth-joint-iterations J --smooth-joint-rounds R`; the
-default is 20, 1000 and 3; 20, 100 and 3 before results/smoothing_budget_all.md),
+default is 20, 1000 and 3; 20, 100 and 3 before results/smoothing_budget_all/smoothing_budget.md),
 and the refine and smooth stages' CPU seconds and the smoothed children's minimum are taken from
 the report. Writes OUT/smoothing_budget.json (every run) and OUT/smoothing_budget.md (a row per
 budget: cases meeting each target, median and worst ratios). About ten minutes on the 2-core
 machine.
 
     python3 experiments/smoothing_budget.py [--records results/real_meshes.jsonl]
-        [--meshes DIR ...] [--out results] [--budgets 20,100,3 20,100,1 6,30,1 3,0,1 1,0,1]
+        [--meshes DIR ...] [--out results] [--budgets 20,1000,3 20,100,3 6,30,1 3,0,1 1,0,1]
+        [--min-input-hexes N]
         [--hexrefine build/experiments/hexrefine] [--report-only]
 
 Meshes are found by file name in the --meshes folders (default ../shared/meshes; the study's
@@ -78,7 +79,12 @@ def run(hexrefine, case, sweeps, joint, rounds, tmp):
     return row
 
 
-def budget_rows(runs):
+def default_budget(result):
+    """The budget that was the default when `result` was run (20, 100, 3 before the records said)."""
+    return tuple(result.get("default_budget", (20, 100, 3)))
+
+
+def budget_rows(runs, default=DEFAULT_BUDGET):
     by = {}
     for r in runs:
         by.setdefault((r["sweeps"], r["joint_iterations"], r.get("joint_rounds", 1)), []).append(r)
@@ -96,7 +102,7 @@ def budget_rows(runs):
                                                                     len(rows)))
             continue
         lines.append("| %d, %d, %d%s | %d | %d | %.1f / %.0f | %d | %.3f | %d |" % (
-            sweeps, joint, rounds, " (default)" if (sweeps, joint, rounds) == DEFAULT_BUDGET
+            sweeps, joint, rounds, " (default)" if (sweeps, joint, rounds) == default
             else "", len(rows),
             sum(1 for t in time if t <= 5), statistics.median(time), max(time),
             sum(1 for q in quality if q >= 0.5 - EPS), statistics.median(quality),
@@ -109,7 +115,7 @@ def write_report(result, out_dir):
     errors = [r for r in runs if "error" in r]
     one = [r for r in runs if (r["sweeps"], r["joint_iterations"]) == (1, 0) and "error" not in r]
     default = [r for r in runs if (r["sweeps"], r["joint_iterations"], r.get("joint_rounds", 1))
-               == DEFAULT_BUDGET and "error" not in r]
+               == default_budget(result) and "error" not in r]
     over = [r for r in one if r["smooth_cpu"] > 5 * r["refine_cpu"]]
     md = ["# The smoothing's budget: quality against time",
           "",
@@ -126,11 +132,12 @@ def write_report(result, out_dir):
               if result.get("min_input_hexes", MIN_INPUT_HEXES) > 0 else "with refined parents",
               result["cases"],
               len({r["mesh"] for r in runs}), len(errors), len(result.get("skipped", []))),
-          ""] + ([result["note"], ""] if result.get("note") else []) + budget_rows(runs) + [""]
+          ""] + ([result["note"], ""] if result.get("note") else []) + \
+        budget_rows(runs, default_budget(result)) + [""]
     large = [r for r in runs if r.get("input_hexes", 0) >= MIN_INPUT_HEXES]
     if result.get("min_input_hexes", MIN_INPUT_HEXES) < MIN_INPUT_HEXES and large:
         md += ["The cases on inputs of at least %d hexes (rockerarm size, the time target's):" %
-               MIN_INPUT_HEXES, ""] + budget_rows(large) + [""]
+               MIN_INPUT_HEXES, ""] + budget_rows(large, default_budget(result)) + [""]
     if one:
         md.append("One sweep and no joint ascent (each node whose worst hex is below 0.5 "
                   "optimized once over the hexes around it) still takes more than 5 x the "
@@ -153,7 +160,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     add_rerun_arguments(ap)
     ap.add_argument("--budgets", nargs="+",
-                    default=["20,100,3", "20,100,1", "6,30,1", "3,0,1", "1,0,1"],
+                    default=["20,1000,3", "20,100,3", "6,30,1", "3,0,1", "1,0,1"],
                     help="S,J[,R]: sweeps, joint iterations, joint rounds (R default 3)")
     ap.add_argument("--min-input-hexes", type=int, default=MIN_INPUT_HEXES,
                     help="the cases on inputs of at least this many hexes (default %d, rockerarm "
@@ -182,7 +189,9 @@ def main():
                             text=True).stdout.strip()
     result = {"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
               "commit": commit, "records": args.records, "mesh_folders": folders,
-              "cases": len(cases), "min_input_hexes": args.min_input_hexes, "budgets": [list(b) for b in budgets], "runs": runs,
+              "cases": len(cases), "min_input_hexes": args.min_input_hexes,
+              "default_budget": list(DEFAULT_BUDGET), "budgets": [list(b) for b in budgets],
+              "runs": runs,
               "skipped": skipped}
     if skipped:
         print("%d cases skipped: mesh not in %s" % (len(skipped), ", ".join(folders)),

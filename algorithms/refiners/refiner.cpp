@@ -89,7 +89,7 @@ std::vector<int32_t> placement_fallback_untangle(HexMesh& refined,
   // second run has no joint ascent: without the cap the ascent raises the scaled Jacobian by
   // collapsing edges (ecr_cap.mesh ball, untangle: largest edge ratio 3.3e8 with it, 183 without),
   // and every later stage caps a hex at its ratio from here.
-  SmoothOptions smoothing;
+  SmoothOptions smoothing;  // the smoothing's default budget: the region is a few hundred hexes
   smoothing.region_hexes = inverted;
   smoothing.layers = 2;
   smoothing.visit_below = 1;

@@ -91,9 +91,9 @@ struct SmoothOptions {
   /// (JointAscentOptions::stall_iterations), so the budget costs only where the ascent still
   /// climbs, which it does slowly but steadily around transitions that must thicken as a layer:
   /// over the real-mesh study's 274 smoothed cases with refined parents
-  /// (results/smoothing_budget_all/smoothing_budget.md) 1000 lifts the children to 0.5 x the parents on 235
-  /// against 218 with 100 (phm_lever_arm surface:0, selective: 0.309 -> 0.591 of the parents),
-  /// at a median 194 x the refinement against 123 x.
+  /// (results/smoothing_budget_all/smoothing_budget.md) 1000 lifts the children to 0.5 x the
+  /// parents on 235 against 218 with 100 (phm_lever_arm surface:0, selective: 0.309 -> 0.591 of the
+  /// parents), at a median 194 x the refinement against 123 x.
   int joint_iterations = 1000;
   /// >= 1: rounds of joint ascent and sweeps, while a round raises the minimum
   /// (JointAscentOptions::rounds; results/smoothing_budget.md compares one round and three on

@@ -15,7 +15,7 @@
 #include <iostream>
 #include <optional>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "algorithms/templates/template_library.hpp"
 #include "experiments/cli.hpp"
 #include "experiments/process_huge_pages.hpp"

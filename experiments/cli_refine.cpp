@@ -1,6 +1,6 @@
 /// \file
 /// `hexrefine refine IN OUT --method M --select SPEC ...`: the refinement pipeline
-/// (algorithms/pipeline.hpp) from a file to a file.
+/// (algorithms/pipeline/pipeline.hpp) from a file to a file.
 ///
 /// OUT (its format and folder) and R are checked before IN is read (cli_output.hpp). The refined
 /// mesh's size is bounded before refining: each pass splits a hex into at most 27, so IN's n hexes
@@ -22,7 +22,7 @@
 #include <limits>
 #include <optional>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "experiments/cli.hpp"
 #include "experiments/cli_output.hpp"
 #include "experiments/process_huge_pages.hpp"

@@ -38,7 +38,7 @@ def fail(message):
 
 
 def record_view(r):
-    """The fields the tables read, lifted out of a record's report (algorithms/pipeline.hpp:
+    """The fields the tables read, lifted out of a record's report (algorithms/pipeline/pipeline.hpp:
     "refine" RefineStats, "check" the refined mesh's checker report, "smoothing" {"stats",
     "check"}; "input" the runner's description of the input). Error records keep "error"."""
     v = dict(r)

@@ -5,7 +5,7 @@ usage: real_meshes_report.py RECORDS.jsonl --out DIR [--quiet]
 
 Reads the records of `hexrefine study` (one per mesh x region kind x arm x method; the arms of
 issue 28: `trilinear` unsmoothed, `default` unsmoothed, `default-smooth`, each run by the
-pipeline, algorithms/pipeline.hpp, and checked against its input) and writes into DIR:
+pipeline, algorithms/pipeline/pipeline.hpp, and checked against its input) and writes into DIR:
   real_meshes.md                  the targets of issue 28 (met and not met), the refusals of
                                   valid inputs with their messages, a summary per mesh and per
                                   arm, the anisotropy cases and every case

@@ -18,7 +18,7 @@
 #include <sstream>
 #include <thread>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"

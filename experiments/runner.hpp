@@ -181,7 +181,7 @@ RunSummary run_plan_execute(const RunPlan& plan, const RunSettings& settings,
                             const RunExecutor& execute);
 
 /// The real executor: builds or reads the mesh, then runs each method through the refinement
-/// pipeline (algorithms/pipeline.hpp); the record is its report plus the input's description,
+/// pipeline (algorithms/pipeline/pipeline.hpp); the record is its report plus the input's description,
 /// wall and CPU seconds, and with save_mesh the file save_mesh_dir/run_mesh_file_name(case,
 /// method) (record: "mesh_file"). A refusal (OperationError) is a record with "error".
 void case_execute(const RunCase& c, const std::vector<std::string>& methods, const RunEmit& emit);

@@ -1,13 +1,13 @@
 /// \file
 /// case_execute: the runner's real executor. Builds (generate) or reads (file) the case's mesh
-/// once, then runs each method through the refinement pipeline (algorithms/pipeline.hpp) on the
+/// once, then runs each method through the refinement pipeline (algorithms/pipeline/pipeline.hpp) on the
 /// same selection; the record is the pipeline's report plus what only the runner knows (the
 /// input's description, wall and CPU time, the saved mesh).
 
 #include <chrono>
 #include <filesystem>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "experiments/runner.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"

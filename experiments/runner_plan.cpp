@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "experiments/runner.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"

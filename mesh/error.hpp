@@ -25,7 +25,7 @@ class OperationError : public std::runtime_error {
 
 /// Node placement could not make every child of a valid input valid (after its retargets and
 /// fallback): a limit of the placement method, not of the input. The pipeline may try another
-/// placement (algorithms/pipeline.cpp).
+/// placement (algorithms/pipeline/pipeline.cpp).
 class PlacementError : public OperationError {
  public:
   using OperationError::OperationError;

@@ -23,7 +23,7 @@
 #include <filesystem>
 #include <string>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "experiments/benchmarks/bench_util.hpp"
 #include "mesh/generators.hpp"
 #include "mesh/io.hpp"

@@ -55,7 +55,7 @@
 #include <string_view>
 #include <vector>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "algorithms/placement/node_placement.hpp"
 #include "algorithms/placement/smoothing.hpp"
 #include "algorithms/refiners/refiner.hpp"

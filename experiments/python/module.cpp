@@ -2,7 +2,7 @@
 /// The compiled part of the Python module `hexrefine` (pybind11): the same library as the command
 /// line, no second implementation. Meshes cross as numpy arrays (float64 n x 3 points, int32
 /// m x 8 hexes in VTK order, int32 per-hex attributes); refinement runs the one pipeline
-/// (algorithms/pipeline.hpp) and returns its report as a dict with the CLI's keys. Long calls
+/// (algorithms/pipeline/pipeline.hpp) and returns its report as a dict with the CLI's keys. Long calls
 /// release the GIL. Errors: bad input -> ValueError (naming the hex, node or spec), a refinement
 /// that cannot be carried out -> hexrefine.RefinementError (a RuntimeError). The package around
 /// it (hexrefine/__init__.py) adds the meshio bridge.
@@ -15,7 +15,7 @@
 #include <filesystem>
 #include <string>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "experiments/runner.hpp"
 #include "mesh/conformity.hpp"
 #include "mesh/error.hpp"

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "fixtures.hpp"
 #include "mesh/io.hpp"
 #include "mesh/quality.hpp"

@@ -8,7 +8,7 @@
 
 #include <optional>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "fixtures.hpp"
 #include "mesh/io.hpp"
 #include "mesh/quality.hpp"

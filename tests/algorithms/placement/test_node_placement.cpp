@@ -12,7 +12,7 @@
 
 #include <cmath>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "algorithms/refiners/selective.hpp"
 #include "algorithms/refiners/sheet.hpp"
 #include "mesh/conformity.hpp"

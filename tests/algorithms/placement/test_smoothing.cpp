@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 #include "fixtures.hpp"
 #include "mesh/error.hpp"
 #include "mesh/io.hpp"

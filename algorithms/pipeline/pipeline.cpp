@@ -1,4 +1,4 @@
-#include "algorithms/pipeline.hpp"
+#include "algorithms/pipeline/pipeline.hpp"
 
 #include <sys/resource.h>
 

@@ -1,15 +1,18 @@
 /// \file
 /// The two commands that regenerate results/ from the code as it is:
-/// - `hexrefine reproduce [--quick] [--resume] [--quiet] [--no-plots]`: the thesis suite
-///   (cases.hpp) to results/thesis.jsonl, tables and plots by experiments/plots.py. The full
-///   suite goes to results/, the quick one (sweeps up to n = 30) to results/quick/, so one never
-///   overwrites the other.
+/// - `hexrefine reproduce [--quick] [--out DIR] [--resume] [--quiet] [--no-plots]`: the thesis
+///   suite (cases.hpp) to results/thesis.jsonl, tables and plots by experiments/plots.py. The full
+///   suite goes to results/ (regenerating the committed results is what it is for); the quick
+///   one (sweeps up to n = 30) to the build folder's results/quick/, so that the README's main
+///   command leaves a clone's tracked files untouched (`git status` stays clean); the committed
+///   results/quick/ is regenerated only on purpose, with `--quick --out results/quick`.
 /// - `hexrefine study [--meshes DIR]... [--no-shared] [--max-hexes-input N] [--out DIR] [--quick]
 ///   [--resume] [--quiet] [--no-plots]`: the real-mesh study (real_mesh_study_cases) over every
 ///   mesh of ../shared/meshes and of each --meshes folder to results/real_meshes.jsonl, report
 ///   and histograms by experiments/real_meshes_report.py; --quick: only the meshes of at most 200
-///   hexes, to results/quick/. The case file names the shared meshes relative to itself (a clean
-///   clone beside ../shared runs it) and the --meshes ones by absolute path (a user's folder).
+///   hexes, to the build folder's results/quick/ (as reproduce's). The case file names the shared
+///   meshes relative to itself (a clean clone beside ../shared runs it) and the --meshes ones by
+///   absolute path (a user's folder).
 /// Each writes its case file beside its records, runs it through the runner and then the
 /// script; a failing script names the rerun command.
 
@@ -19,6 +22,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "experiments/cases.hpp"
 #include "experiments/cli.hpp"
@@ -40,10 +44,30 @@ std::string shell_quote(const std::string& s) {
   return out + "'";
 }
 
-fs::path results_dir(bool quick) {
-  const fs::path dir = fs::path(run_source_dir()) / "results" / (quick ? "quick" : "");
+/// The build folder the binary was configured in (HEXREFINE_BINARY_DIR), where quick runs write.
+std::string build_dir() {
+#ifdef HEXREFINE_BINARY_DIR
+  return HEXREFINE_BINARY_DIR;
+#else
+  return (fs::path(run_source_dir()) / "build").string();
+#endif
+}
+
+/// Where a run writes: --out DIR when given (InputError naming it when it cannot be made),
+/// else the build folder's results/quick/ for --quick, else the source tree's results/.
+fs::path results_dir(const CliArgs& a, const std::string& command, bool quick) {
+  fs::path dir;
+  const std::optional<std::string> out = a.value("--out");
+  if (out)
+    dir = fs::absolute(*out).lexically_normal();
+  else
+    dir = quick ? fs::path(build_dir()) / "results" / "quick"
+                : fs::path(run_source_dir()) / "results";
   std::error_code ec;
   fs::create_directories(dir, ec);
+  if (ec && out)
+    throw InputError("hexrefine " + command + ": --out " + *out +
+                     ": cannot create: " + ec.message());
   if (ec) throw OperationError(dir.string() + ": cannot create: " + ec.message());
   return dir;
 }
@@ -87,7 +111,7 @@ int reproduce_run(const CliArgs& a) {
   if (!a.positional.empty())
     throw InputError("hexrefine reproduce: unexpected argument '" + a.positional[0] + "'");
   const bool quick = a.flag("--quick");
-  const fs::path results = results_dir(quick);
+  const fs::path results = results_dir(a, "reproduce", quick);
   const std::string meshes = meshes_dir().lexically_relative(results).string();
   return suite_run(
       a, thesis_suite_cases(quick, meshes, "thesis.jsonl"), results / "cases.json", "plots.py",
@@ -122,15 +146,7 @@ int study_run(const CliArgs& a) {
   if (const auto v = a.value("--max-hexes-input"))
     max_hexes = cli_parse_int_in(*v, 1, INT64_MAX, "--max-hexes-input");
   if (quick) max_hexes = std::min<int64_t>(max_hexes, 200);
-  fs::path results;
-  if (const auto out = a.value("--out")) {
-    results = fs::absolute(*out).lexically_normal();
-    std::error_code ec;
-    fs::create_directories(results, ec);
-    if (ec) throw InputError("hexrefine study: --out " + *out + ": cannot create: " + ec.message());
-  } else {
-    results = results_dir(quick);
-  }
+  const fs::path results = results_dir(a, "study", quick);
   const fs::path case_file = results / "real_meshes.cases.json";
 
   std::vector<StudyMesh> meshes;
@@ -181,7 +197,12 @@ const CliCommand cli_reproduce_command = {
     "",
     "Runs the thesis suite and regenerates results/ (tables, plots, records).",
     {
-        {"--quick", "", "stop the G-2 and G-3 sweeps at n = 30 and write results/quick/"},
+        {"--quick", "",
+         "stop the G-2 and G-3 sweeps at n = 30 and write the build folder's results/quick/"},
+        {"--out", "DIR",
+         "write the case file, records, tables and plots to DIR (default results/, or with "
+         "--quick build/results/quick/; --quick --out results/quick regenerates the committed "
+         "quick results)"},
         {"--resume", "", "keep the records already written"},
         {"--quiet", "", "no progress lines"},
         {"--no-plots", "", "records only: skip experiments/plots.py"},
@@ -200,8 +221,11 @@ const CliCommand cli_study_command = {
          "study every mesh file of DIR too, read from DIR as given (tagged with its folder)", true},
         {"--no-shared", "", "leave out ../shared/meshes (only the --meshes folders)"},
         {"--max-hexes-input", "N", "leave out the meshes of more than N hexes (named on stderr)"},
-        {"--out", "DIR", "write the case file, records and report to DIR (default results/)"},
-        {"--quick", "", "only the meshes of at most 200 hexes, to results/quick/"},
+        {"--out", "DIR",
+         "write the case file, records and report to DIR (default results/, or with --quick "
+         "build/results/quick/)"},
+        {"--quick", "",
+         "only the meshes of at most 200 hexes, to the build folder's results/quick/"},
         {"--resume", "", "keep the records already written"},
         {"--quiet", "", "no progress lines"},
         {"--no-plots", "", "records only: skip experiments/real_meshes_report.py"},

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -185,6 +186,38 @@ TEST(RealMeshesReport, CountsTheTargetsOfIssue28PerArm) {
   EXPECT_EQ(none.exit_code, 2);
   EXPECT_NE(none.output.find("no records of the real-mesh study"), std::string::npos)
       << none.output;
+}
+
+// The README's main command must leave a clone's tracked files alone: --quick writes the build
+// folder's results/quick/, and nothing under the source tree changes (git status stays the same).
+TEST(CliStudy, QuickWritesTheBuildFolderAndLeavesTrackedFilesAlone) {
+  const auto dir = test_temp_dir("cli_study_quick");
+  const fs::path meshes = dir / "meshes";
+  fs::create_directories(meshes);
+  ASSERT_EQ(
+      cli_run("generate brick '" + (meshes / "brick.mesh").string() + "' --dims 2,2,2").exit_code,
+      0);
+  const std::string status_cmd = std::string("git -C '") + HEXREFINE_SOURCE_DIR +
+                                 "' status --porcelain --untracked-files=all 2>/dev/null";
+  auto git_status = [&] {
+    std::string text;
+    if (FILE* p = ::popen(status_cmd.c_str(), "r")) {
+      char buffer[4096];
+      size_t n;
+      while ((n = ::fread(buffer, 1, sizeof buffer, p)) > 0) text.append(buffer, n);
+      ::pclose(p);
+    }
+    return text;
+  };
+  const std::string before = git_status();
+  const fs::path records =
+      fs::path(HEXREFINE_BINARY_DIR) / "results" / "quick" / "real_meshes.jsonl";
+  fs::remove(records);
+  const CliRun r =
+      cli_run("study --quick --meshes '" + meshes.string() + "' --no-shared --quiet --no-plots");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(jsonl_read(records.string()).records.size(), (7 * 3 + 9 * 3) * 2u);
+  EXPECT_EQ(git_status(), before);
 }
 
 }  // namespace

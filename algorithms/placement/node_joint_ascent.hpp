@@ -50,9 +50,10 @@ struct JointAscentOptions {
   /// A hex whose edge ratio nears its cap (within the last twentieth) adds a sample to the soft
   /// minimum that falls to 0 at the cap (node_joint_ascent.cpp), so the ascent is steered along
   /// the cap. false: the cap is only a wall, and a hex the sweeps left at its cap stops the
-  /// ascent at its first step (docs/placement-and-smoothing.md, 'Smoothing'). Smoothing sets it; node placement and the template table's optimizer
-  /// (`hexrefine templates --optimize`) keep the wall, so that the committed table and the
-  /// placement figures (results/placement.md) stay reproducible.
+  /// ascent at its first step (docs/placement-and-smoothing.md, 'Smoothing'). Smoothing sets it;
+  /// node placement and the template table's optimizer (`hexrefine templates --optimize`) keep
+  /// the wall, so that the committed table and the placement figures (results/placement.md)
+  /// stay reproducible.
   bool cap_samples = false;
   /// >= 1: rounds of nodes_sweep_and_ascend (ascent, then sweeps from the nodes it moved), each
   /// with beta `round_beta_growth` (>= 1) times the last, while a round raises the minimum over

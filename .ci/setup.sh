@@ -3,6 +3,7 @@
 # clang-14 and libclang-rt-14-dev (libFuzzer, ASan, UBSan) build the reader fuzz targets;
 # pybind11-dev, python3-dev, python3-numpy and python3-pytest build and test the Python module;
 # python3-jsonschema validates reports and records against docs/schema/.
+# python3-venv and python3-setuptools test `pip install .` (tests/install).
 # universal-ctags measures function lengths for .ci/function_lengths.py.
 # valgrind counts the instructions of the performance gate (hexrefine bench --instructions).
 # python3-dolfinx solves the adaptive loop's Poisson problems (experiments/adaptive).
@@ -10,7 +11,7 @@ set -euo pipefail
 packages=(cmake g++ make clang-format libeigen3-dev libopenmesh-dev nlohmann-json3-dev libgtest-dev
           libbenchmark-dev libexodusii-dev python3-meshio python3-vtk9 python3-matplotlib gmsh
           clang-14 libclang-rt-14-dev pybind11-dev python3-dev python3-numpy python3-pytest
-          python3-jsonschema zlib1g-dev valgrind universal-ctags
+          python3-jsonschema zlib1g-dev valgrind universal-ctags python3-venv python3-setuptools
           python3-dolfinx)
 missing=()
 for p in "${packages[@]}"; do

@@ -3,10 +3,10 @@
 ///
 /// Why: the command's large arrays (an 11.4 M-hex output is about 0.6 GB of cells and points,
 /// its check as much again) are written into fresh memory, one 4 KiB page fault each. On the
-/// virtual 2-core machine we measure on, those faults dominate: writing 642 MB into fresh pages
-/// took 2.16 s with 4 KiB pages and 0.07 s with 2 MiB pages (bench_refiners' floor, 2026-11-25).
-/// Where the kernel gives huge pages only to ranges that ask for them
-/// (/sys/kernel/mm/transparent_hugepage/enabled = "madvise", Debian's default), glibc's malloc
+/// virtual 2-core machine we measure on, those faults dominate the writes (figures:
+/// results/bench/README.md, "Figures behind the code's comments"). Where the kernel gives huge
+/// pages only to ranges that ask for them (/sys/kernel/mm/transparent_hugepage/enabled =
+/// "madvise", Debian's default), glibc's malloc
 /// asks for them on its own large chunks when started with the tunable glibc.malloc.hugetlb=1
 /// (glibc >= 2.35). Tunables are read once at process start, so the command sets it and
 /// re-executes itself, once, before doing anything else. Output does not depend on it.

@@ -4,8 +4,8 @@
 /// runner, the benchmarks, the Python module):
 ///   read -> select -> refine (per pass: plan, apply, place nodes) -> check -> smooth -> check
 ///   -> write,
-/// each stage timed (PipelineResult::stage_seconds), the report one JSON object
-/// (pipeline_report) with the same keys wherever it is written.
+/// each stage timed (stage_seconds), the report one JSON object (pipeline_report; its "check"
+/// is the mesh written's), each stage a function in a file of its own (pipeline.cpp lists them).
 ///
 /// Verdicts: the result is checked against the input by the project's checker
 /// (mesh/conformity.hpp). Without an ablation switch (ranking, propagation or ebe_only off) or
@@ -132,9 +132,18 @@ struct PipelineResult {
   /// The same hexes after smoothing (which also moves nodes of input hexes around them: those
   /// are held by its guarantee that the mesh-wide minimum never decreases).
   std::optional<double> smoothed_children_min_scaled_jacobian;
-  MeshCheckReport check;  ///< the refined mesh against the input
+  /// The refined mesh against the input, before any smoothing. Without smoothing it is the
+  /// output's check; with smoothing the output's is smoothed_check (output_check() is the one
+  /// of the mesh returned and written). Report: "check" without smoothing,
+  /// "smoothing.refined_check" with it.
+  MeshCheckReport check;
   std::optional<SmoothStats> smoothing;
-  std::optional<MeshCheckReport> smoothed_check;  ///< the smoothed mesh against the input
+  /// The smoothed mesh against the input, set when smoothing ran: the output's check (report:
+  /// "check").
+  std::optional<MeshCheckReport> smoothed_check;
+  /// The check of the mesh returned and written: the smoothed mesh's when smoothing ran, else
+  /// the refined mesh's.
+  const MeshCheckReport& output_check() const { return smoothed_check ? *smoothed_check : check; }
   /// Smoothed nodes put back to their unsmoothed positions because the checker rejected the
   /// smoothed mesh around them (0 when it passed at once), and what the check said then (empty
   /// when it passed at once): smoothing returns a valid mesh, at worst the unsmoothed one.
@@ -171,13 +180,14 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
 /// record too): raised whenever a key is renamed, removed or changes its type or unit, or a key
 /// is added outside the objects the schema leaves open (docs/schema/report.schema.json; the
 /// changelog is in docs/report.md).
-inline constexpr int pipeline_report_schema_version = 1;
+inline constexpr int pipeline_report_schema_version = 2;
 
 /// The report: "method", "options" (RefineOptions plus "smooth"), "selection" ({"specs",
 /// "hexes", "warning"?}), "refine" (RefineStats), "refined_parents" ({"hexes",
 /// "min_scaled_jacobian", "children_min_scaled_jacobian",
-/// "smoothed_children_min_scaled_jacobian"?}), "check", "smoothing"? ({"stats", "check",
-/// "nodes_undone", "max_sweeps", "max_joint_iterations", "max_joint_rounds", "warning"?}: the
+/// "smoothed_children_min_scaled_jacobian"?}), "check" (the output's: output_check()),
+/// "smoothing"? ({"stats", "refined_check" (the refined mesh's before smoothing), "nodes_undone",
+/// "max_sweeps", "max_joint_iterations", "max_joint_rounds", "both_starts", "warning"?}: the
 /// three max_ are the smoothing's budget, options.smoothing's), "stage_seconds",
 /// "stage_cpu_seconds", "peak_memory_mb". The CLI writes it with --report, the runner adds its
 /// identification fields to it, the Python module returns it as a dict.

@@ -50,10 +50,10 @@ nlohmann::json pipeline_report(const PipelineResult& r, const PipelineOptions& o
   if (r.smoothed_children_min_scaled_jacobian)
     j["refined_parents"]["smoothed_children_min_scaled_jacobian"] =
         *r.smoothed_children_min_scaled_jacobian;
-  j["check"] = r.check;
+  j["check"] = r.output_check();  // the mesh written (docs/report.md, schema_version 2)
   if (r.smoothing) {
     j["smoothing"] = {{"stats", *r.smoothing},
-                      {"check", *r.smoothed_check},
+                      {"refined_check", r.check},
                       {"nodes_undone", r.smoothing_nodes_undone},
                       {"max_sweeps", o.smoothing.max_sweeps},
                       {"max_joint_iterations", o.smoothing.joint_iterations},

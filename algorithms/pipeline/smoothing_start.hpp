@@ -6,8 +6,8 @@
 /// smoothing_both_starts) both are computed as values and a policy, a pure function of the two
 /// (smoothing_start_choose_fallback, smoothing_start_choose_both), says which one is kept: the
 /// policies never run a stage themselves, and are tested on hand-built values
-/// (tests/algorithms/pipeline/test_smoothing_start.cpp). Why smoothing has two starts at all:
-/// docs/placement-and-smoothing.md, "Where smoothing starts".
+/// (tests/algorithms/pipeline/test_smoothing_start.cpp). Why two starts: docs/placement-and-
+/// smoothing.md, "--smooth never ends below plain refine" and "Both starts".
 
 #include <cstdint>
 #include <optional>

@@ -4,8 +4,8 @@
 /// runner, the benchmarks, the Python module):
 ///   read -> select -> refine (per pass: plan, apply, place nodes) -> check -> smooth -> check
 ///   -> write,
-/// each stage timed (PipelineResult::stage_seconds), the report one JSON object
-/// (pipeline_report) with the same keys wherever it is written.
+/// each stage timed (stage_seconds), the report one JSON object (pipeline_report; its "check"
+/// is the mesh written's), each stage a function in a file of its own (pipeline.cpp lists them).
 ///
 /// Verdicts: the result is checked against the input by the project's checker
 /// (mesh/conformity.hpp). Without an ablation switch (ranking, propagation or ebe_only off) or
@@ -44,9 +44,9 @@ namespace hexrefine {
 
 /// The node placement of a run that names none: `untangle` when the run smooths, `optimized`
 /// otherwise. Smoothing raises the quality from positions that have not yet used up the
-/// edge-ratio room (PlacementOptions::max_edge_ratio): measured on
-/// `sphere_conforming.mesh --select surface:0 --method selective --smooth` it ends at 0.460 from
-/// untangle against 0.294 from optimized, in a third of the time (results/smooth_start.md).
+/// edge-ratio room (PlacementOptions::max_edge_ratio), so from untangle it ends higher, and
+/// sooner, than from optimized (docs/placement-and-smoothing.md, "Which placement to smooth
+/// from"; results/smooth_start.md).
 /// Every front end (CLI `refine`, the runner's cases, the Python module) resolves an absent
 /// placement through this, and the report's options.placement.method names the one used.
 inline PlacementMethod pipeline_default_placement(bool smooth) {
@@ -79,21 +79,23 @@ struct PipelineOptions {
   int smoothing_pin_rounds = 3;
   /// `--smooth` from `untangle` (the default start, pipeline_default_placement): when the
   /// smoothing ends below the minimum the `optimized` placement gives unsmoothed (plain
-  /// `refine`'s default), the run is done again placed by `optimized` and smoothed from there,
-  /// which never ends below that minimum (5 of 274 smoothed cases of the real-mesh study ended
-  /// below it at 2c8624b: ecr_cap surface:0, sheet, 0.2503 against 0.2749). So `--smooth` never
-  /// ends below plain `refine` where the checker accepts the smoothing at once, as on every
-  /// case of the study; after a rejection the pin and undo rounds hold only the untangle start's
-  /// own minimum. Should the optimized run fail a check, the untangle start stands. The
-  /// optimized placement is billed to the smooth stage. false: one start only (ablation, tests).
+  /// `refine`'s default), the optimized start is checked and smoothed too and kept instead,
+  /// which never ends below that minimum (a few cases of the real-mesh study ended below it:
+  /// docs/placement-and-smoothing.md, "--smooth never ends below plain refine"). So `--smooth`
+  /// never ends below plain `refine` where the checker accepts the smoothing at once, as on
+  /// every case of the study; after a rejection the pin and undo rounds hold only the untangle
+  /// start's own minimum. Should the optimized start fail a check, the untangle start stands.
+  /// The optimized placement is billed to the smooth stage. The policy:
+  /// smoothing_start_choose_fallback (algorithms/pipeline/smoothing_start.hpp). false: one
+  /// start only (ablation, tests).
   bool smoothing_start_fallback = true;
   /// `--smooth` from both starts (`refine --smooth-both-starts`): placed by `untangle` and
   /// smoothed, placed by `optimized` and smoothed, and the one with the higher smoothed minimum
-  /// kept (the untangle one on a tie); both refinements and smoothings are billed, about twice
-  /// the time. Neither start is the better one on every case: over the real-mesh study's
-  /// smoothed cases below 0.5 x their parents the optimized start ends higher on 35 of 68,
-  /// lower on 19, and lifts 11 to 0.5 x (results/smoothing_starts.md). Only where the start is
-  /// `untangle` (the default with smoothing).
+  /// kept (the untangle one on a tie; the policy: smoothing_start_choose_both); both
+  /// refinements and smoothings are billed, about twice the time. Neither start is the better
+  /// one on every case of the real-mesh study (docs/placement-and-smoothing.md, "Both starts";
+  /// results/smoothing_starts.md). Only where the start is `untangle` (the default with
+  /// smoothing).
   bool smoothing_both_starts = false;
   /// Refuse before refining when n * 27^passes could exceed this many output hexes (int32 ids).
   int64_t max_hexes = std::numeric_limits<int32_t>::max();
@@ -130,9 +132,18 @@ struct PipelineResult {
   /// The same hexes after smoothing (which also moves nodes of input hexes around them: those
   /// are held by its guarantee that the mesh-wide minimum never decreases).
   std::optional<double> smoothed_children_min_scaled_jacobian;
-  MeshCheckReport check;  ///< the refined mesh against the input
+  /// The refined mesh against the input, before any smoothing. Without smoothing it is the
+  /// output's check; with smoothing the output's is smoothed_check (output_check() is the one
+  /// of the mesh returned and written). Report: "check" without smoothing,
+  /// "smoothing.refined_check" with it.
+  MeshCheckReport check;
   std::optional<SmoothStats> smoothing;
-  std::optional<MeshCheckReport> smoothed_check;  ///< the smoothed mesh against the input
+  /// The smoothed mesh against the input, set when smoothing ran: the output's check (report:
+  /// "check").
+  std::optional<MeshCheckReport> smoothed_check;
+  /// The check of the mesh returned and written: the smoothed mesh's when smoothing ran, else
+  /// the refined mesh's.
+  const MeshCheckReport& output_check() const { return smoothed_check ? *smoothed_check : check; }
   /// Smoothed nodes put back to their unsmoothed positions because the checker rejected the
   /// smoothed mesh around them (0 when it passed at once), and what the check said then (empty
   /// when it passed at once): smoothing returns a valid mesh, at worst the unsmoothed one.
@@ -169,13 +180,14 @@ PipelineResult pipeline_run_files(const std::string& in, const std::string& out,
 /// record too): raised whenever a key is renamed, removed or changes its type or unit, or a key
 /// is added outside the objects the schema leaves open (docs/schema/report.schema.json; the
 /// changelog is in docs/report.md).
-inline constexpr int pipeline_report_schema_version = 1;
+inline constexpr int pipeline_report_schema_version = 2;
 
 /// The report: "method", "options" (RefineOptions plus "smooth"), "selection" ({"specs",
 /// "hexes", "warning"?}), "refine" (RefineStats), "refined_parents" ({"hexes",
 /// "min_scaled_jacobian", "children_min_scaled_jacobian",
-/// "smoothed_children_min_scaled_jacobian"?}), "check", "smoothing"? ({"stats", "check",
-/// "nodes_undone", "max_sweeps", "max_joint_iterations", "max_joint_rounds", "warning"?}: the
+/// "smoothed_children_min_scaled_jacobian"?}), "check" (the output's: output_check()),
+/// "smoothing"? ({"stats", "refined_check" (the refined mesh's before smoothing), "nodes_undone",
+/// "max_sweeps", "max_joint_iterations", "max_joint_rounds", "both_starts", "warning"?}: the
 /// three max_ are the smoothing's budget, options.smoothing's), "stage_seconds",
 /// "stage_cpu_seconds", "peak_memory_mb". The CLI writes it with --report, the runner adds its
 /// identification fields to it, the Python module returns it as a dict.

@@ -144,7 +144,7 @@ int refine_run(const CliArgs& a) {
     report["huge_pages"] = process_uses_huge_pages();
     file_write_atomically(*report_path, [&](std::ostream& os) { os << report.dump(2) << "\n"; });
   }
-  const MeshCheckReport& final_check = r.smoothed_check ? *r.smoothed_check : r.check;
+  const MeshCheckReport& final_check = r.output_check();
   std::cout << o.method << ": " << r.stats.initial_hexes << " -> " << r.stats.final_hexes
             << " hexes, " << (final_check.conformal ? "conformal" : "NOT conformal") << ", "
             << final_check.inverted_hexes << " inverted, min scaled Jacobian "

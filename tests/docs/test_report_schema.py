@@ -80,7 +80,7 @@ def test_cli_refine_report_validates(brick, tmp_path, method, extra):
     hexrefine_cli(*args, *extra)
     report = json.loads(report_path.read_text())
     assert errors(REPORT, report) == []
-    assert report["schema_version"] == 1
+    assert report["schema_version"] == 2
     assert report["input"] == str(brick) and report["output"] == str(tmp_path / "out.vtu")
     assert ("smoothing" in report) == ("--smooth" in extra)
     assert report["check"]["reference_compared"] and report["check"]["valid"]
@@ -102,7 +102,7 @@ def test_cli_run_records_validate(brick, tmp_path):
         ("L", "selective"), ("L", "sheet"), ("gen", "sheet"), ("bad-spec", "selective")]
     for r in records:
         assert errors(RECORD, r) == [], r
-        assert r["schema_version"] == 1
+        assert r["schema_version"] == 2
     assert "smoothing" in records[0] and "mesh_file" in records[2]
     assert records[3]["error_kind"] == "input" and records[3]["expect"] == "refused"
 
@@ -129,10 +129,33 @@ def report(brick, tmp_path_factory):
     return json.loads((tmp / "r.json").read_text())
 
 
+def test_the_check_is_the_written_meshs_the_refined_one_is_named_so(brick, tmp_path):
+    """schema_version 2: the top-level check describes the mesh written (the smoothed one), the
+    refined mesh's check before smoothing is smoothing.refined_check."""
+    args = ["refine", brick, tmp_path / "o.mesh", "--method", "selective", "--smooth", "--report",
+            tmp_path / "r.json"]
+    for spec in L_SHAPE:
+        args += ["--select", spec]
+    hexrefine_cli(*args)
+    report = json.loads((tmp_path / "r.json").read_text())
+    hexrefine_cli("check", tmp_path / "o.mesh", "--reference", brick, "--report",
+                  tmp_path / "c.json")
+    written = json.loads((tmp_path / "c.json").read_text())
+    for key in ("hexes", "nodes", "valid", "inverted_hexes"):
+        assert report["check"][key] == written[key], key
+    assert report["check"]["min_scaled_jacobian"] == pytest.approx(
+        written["min_scaled_jacobian"], abs=1e-9)
+    smoothing = report["smoothing"]
+    assert "check" not in smoothing
+    refined = smoothing["refined_check"]["min_scaled_jacobian"]
+    assert refined == pytest.approx(smoothing["stats"]["min_scaled_jacobian_before"], abs=1e-9)
+    assert written["min_scaled_jacobian"] > refined + 0.01  # the smoothing moved the minimum
+
+
 @pytest.mark.parametrize("path", [("refine",), ("check",), ("schema_version",),
                                   ("refine", "final_hexes"), ("refine", "initial_hexes"),
                                   ("refine", "placement"), ("check", "inverted_hexes"),
-                                  ("check", "conformal"), ("smoothing", "check", "hexes"),
+                                  ("check", "conformal"), ("smoothing", "refined_check", "hexes"),
                                   ("selection", "hexes"), ("stage_seconds", "total")])
 def test_a_report_without_its_counts_is_rejected(report, path):
     assert errors(REPORT, report) == []
@@ -149,7 +172,7 @@ def test_wrong_types_and_unknown_keys_outside_the_open_objects_are_rejected(repo
                    lambda r: r["check"].update(conformal=1),
                    lambda r: r["check"]["scaled_jacobian_histogram"]["counts"].pop(),
                    lambda r: r["options"]["placement"].update(method="nearest"),
-                   lambda r: r.update(schema_version=2),
+                   lambda r: r.update(schema_version=1),  # the keys of version 1
                    lambda r: r.update(final_hexes=8060),  # the flat keys of the old records
                    lambda r: r["selection"].update(count=3),
                    lambda r: r["options"].pop("threads")):
@@ -181,7 +204,7 @@ def test_a_record_is_a_result_or_an_error():
                                        "joint_iterations": 100, "max_edge_ratio": 20}},
              "tags": {}, "commit": "unknown", "commit_dirty": False,
              "machine": {"cpu": "x", "cores": 2}, "build_type": "release",
-             "timestamp": "2026-11-26T12:00:00Z", "schema_version": 1}
+             "timestamp": "2026-11-26T12:00:00Z", "schema_version": 2}
     error = dict(ident, error="cannot refine", error_kind="operation")
     assert errors(RECORD, error) == []
     assert errors(RECORD, dict(error, error_kind="crash")) != []
@@ -214,4 +237,4 @@ def test_docs_report_md_holds_the_schemas_key_tables_and_names_every_key():
     result = subprocess.run(["/usr/bin/python3", str(SCHEMA_DIR / "key_tables.py")],
                             capture_output=True, text=True, check=True)
     assert result.stdout.strip() in text  # else: python3 docs/schema/key_tables.py --update
-    assert "## Changelog" in text and "schema_version 1" in text
+    assert "## Changelog" in text and "schema_version 1" in text and "schema_version 2" in text

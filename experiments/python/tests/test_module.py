@@ -149,10 +149,13 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
     # children optimised, one stretched to the default edge-ratio cap of 20; smoothed: sweeps,
     # then three rounds of joint ascent and sweeps, steered along the cap), no hex stretched
     # past the cap.
-    assert report_one["check"]["min_scaled_jacobian"] == 0.11023223760640442
-    assert report_two["smoothing"]["check"]["min_scaled_jacobian"] == 0.5457535571145382
-    assert 19.9 < report_one["check"]["max_edge_ratio"] <= 20 * (1 + 1e-9)
-    assert 19 < report_two["smoothing"]["check"]["max_edge_ratio"] <= 20 * (1 + 1e-9)
+    # The report's check is the output's (smoothed); the refined mesh's before smoothing is
+    # smoothing.refined_check (schema_version 2, docs/report.md).
+    assert report_one["smoothing"]["refined_check"]["min_scaled_jacobian"] == 0.11023223760640442
+    assert report_two["check"]["min_scaled_jacobian"] == 0.5457535571145382
+    assert 19.9 < report_one["smoothing"]["refined_check"]["max_edge_ratio"] <= 20 * (1 + 1e-9)
+    assert 19 < report_two["check"]["max_edge_ratio"] <= 20 * (1 + 1e-9)
+    assert "check" not in report_two["smoothing"]
     # Without the cap, the scaled Jacobian alone: higher minima by collapsed edges.
     _, uncapped = hexrefine.refine(mesh, "sphere:0,0,0,5", max_edge_ratio=0)
     assert uncapped["check"]["min_scaled_jacobian"] == 0.11783137589340247
@@ -164,17 +167,17 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
     # optimized: with the default budget both end at the same worst hex).
     _, report = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True)
     assert report["options"]["placement"]["method"] == "untangle"
-    assert report["smoothing"]["check"]["min_scaled_jacobian"] == 0.5457535571145382
+    assert report["check"]["min_scaled_jacobian"] == 0.5457535571145382
     assert report["smoothing"]["nodes_undone"] == 0 and "warning" not in report["smoothing"]
     assert (report["smoothing"]["max_sweeps"], report["smoothing"]["max_joint_iterations"],
             report["smoothing"]["max_joint_rounds"]) == (20, 1000, 3)
     _, one_round = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_joint_rounds=1)
-    assert one_round["smoothing"]["check"]["min_scaled_jacobian"] == 0.5003094177402794
+    assert one_round["check"]["min_scaled_jacobian"] == 0.5003094177402794
     assert one_round["smoothing"]["stats"]["joint_rounds"] == 1
     # A smaller budget: faster, lower (refine --smooth-sweeps 2 --smooth-joint-iterations 0).
     _, budget = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=2,
                                  smooth_joint_iterations=0)
-    assert budget["smoothing"]["check"]["min_scaled_jacobian"] == 0.1972858580749072
+    assert budget["check"]["min_scaled_jacobian"] == 0.1972858580749072
     assert budget["smoothing"]["stats"]["joint_iterations"] == 0
     with pytest.raises(ValueError, match="smooth_sweeps"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=0)
@@ -190,15 +193,14 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
                                     smooth_sweeps=2, smooth_joint_iterations=0)
     _, both = hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, smooth_sweeps=2,
                                smooth_joint_iterations=0, smooth_both_starts=True)
-    from_optimized = optimized["smoothing"]["check"]["min_scaled_jacobian"]
+    from_optimized = optimized["check"]["min_scaled_jacobian"]
     assert from_optimized != 0.1972858580749072
-    assert both["smoothing"]["check"]["min_scaled_jacobian"] == max(0.1972858580749072,
-                                                                    from_optimized)
+    assert both["check"]["min_scaled_jacobian"] == max(0.1972858580749072, from_optimized)
     kept = "optimized" if from_optimized > 0.1972858580749072 else "untangle"
     assert both["options"]["placement"]["method"] == kept
     assert ("smoothed from both starts" in both["refine"].get("placement_warning", "")) == (
         kept == "optimized")
-    assert both["smoothing"]["check"]["valid"]
+    assert both["check"]["valid"]
     with pytest.raises(ValueError, match="smooth_both_starts needs smooth=True"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth_both_starts=True)
     with pytest.raises(ValueError, match="takes no placement but 'untangle'"):

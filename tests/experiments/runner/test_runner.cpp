@@ -429,7 +429,7 @@ TEST(RunPlanExecute, ExpectedRefusalsAreCountedApartFromErrors) {
   EXPECT_FALSE(records[4].contains("expect"));
   EXPECT_EQ(records[5]["expect"], "refused");
   EXPECT_FALSE(records[5].contains("error"));
-  for (const json& r : records) EXPECT_EQ(r["schema_version"], 1) << r.dump();
+  for (const json& r : records) EXPECT_EQ(r["schema_version"], 2) << r.dump();
   RunSummary clean = s;
   clean.refusals_missing = 0;
   EXPECT_EQ(run_summary_counts(clean),

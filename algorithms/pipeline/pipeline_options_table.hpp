@@ -2,9 +2,9 @@
 /// \file
 /// The pipeline's options, declared once: one row per option (its key, type, default, help,
 /// check and how it sets PipelineOptions), from which every front end derives its own spelling:
-/// the CLI's `refine` flags and help lines (experiments/cli_refine.cpp), the keywords of the
+/// the CLI's `refine` flags and help lines (experiments/cli/cli_refine.cpp), the keywords of the
 /// Python `hexrefine.refine` (experiments/python/module.cpp, hexrefine/__init__.py) and the keys
-/// of a case file (experiments/runner_plan.cpp). A front end turns what it was given into
+/// of a case file (experiments/runner/runner_plan.cpp). A front end turns what it was given into
 /// *settings*, one JSON object {key: value}, and pipeline_options_set checks and applies them, so
 /// a check or a default is written here and nowhere else.
 ///

@@ -17,7 +17,7 @@
 
 #include "algorithms/pipeline/pipeline.hpp"
 #include "algorithms/pipeline/pipeline_options_table.hpp"
-#include "experiments/runner.hpp"
+#include "experiments/runner/runner.hpp"
 #include "mesh/conformity.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"

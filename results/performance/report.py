@@ -289,7 +289,7 @@ def command_section():
         w(f"Huge pages: the same commands with `HEXREFINE_HUGE_PAGES=0` (4 KiB pages; "
           f"`command_no_huge_pages.json`, {q['date']}, right after the run above). The command "
           "re-executes itself with glibc's `glibc.malloc.hugetlb=1` where the kernel gives "
-          "transparent huge pages on request (`experiments/process_huge_pages.hpp`); each "
+          "transparent huge pages on request (`experiments/bench/process_huge_pages.hpp`); each "
           "report records whether it ran with them.")
         w("")
         w("| command | threads | wall s, huge pages | wall s, 4 KiB pages | refine stage, huge | refine stage, 4 KiB |")
@@ -421,7 +421,7 @@ def checker_section():
                      f"one (CPU {one['cpu_s']['median']:.3f} s, "
                      f"{one['hexes_per_cpu_s'] / 1e6:.1f} M hexes per CPU second)")
     w("The checker without a reference (what `hexrefine check` runs), medians: " +
-      "; ".join(rates) + ". `mesh_check` rows: bench_checker (experiments/benchmarks), the mesh")
+      "; ".join(rates) + ". `mesh_check` rows: bench_checker (experiments/bench), the mesh")
     w("in memory, CPU time the process's (both threads); `hexrefine check` rows: the command's")
     w("check stage from its report (read stage left out). The refine rows: the whole command's")
     w("wall time by the script's clock around the process, against the refine stage of the same")

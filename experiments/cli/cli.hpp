@@ -76,6 +76,12 @@ int cli_threads(const std::optional<std::string>& value);
 
 int cli_main(int argc, char** argv);
 
+struct PipelineOptions;
+/// `refine`'s pipeline options from its parsed arguments: --method, --select, the options of the
+/// table (algorithms/pipeline/pipeline_options_table.hpp) and --threads; InputError naming a bad
+/// one. What `refine` runs, and what its tests compare with the other front ends'.
+PipelineOptions cli_refine_options(const CliArgs& args);
+
 // The commands (each defined in its cli_*.cpp).
 extern const CliCommand cli_generate_command;
 extern const CliCommand cli_check_command;

@@ -15,17 +15,23 @@
 /// With an ablation switch (--no-ranking, --no-propagation, --ebe-only) the result may be
 /// non-conformal by design: it is written and the checker's counts go to the report. A selection
 /// that matches nothing: a warning, the mesh is written unchanged, exit 0.
+///
+/// The pipeline's options (--passes ... --max-hexes) are not written here: their flags, help
+/// lines and checks come from the one table of algorithms/pipeline/pipeline_options_table.hpp,
+/// spelt the CLI's way (`--max-edge-ratio`, `--no-ranking`; values as the table spells them,
+/// `by_rank`). This file adds what is the CLI's own: what to refine, the output and --threads.
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <iostream>
-#include <limits>
 #include <optional>
 
 #include "algorithms/pipeline/pipeline.hpp"
+#include "algorithms/pipeline/pipeline_options_table.hpp"
+#include "experiments/bench/process_huge_pages.hpp"
 #include "experiments/cli/cli.hpp"
 #include "experiments/cli/cli_output.hpp"
-#include "experiments/bench/process_huge_pages.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
 
@@ -39,10 +45,83 @@ std::string methods_list() {
   return s;
 }
 
-int refine_run(const CliArgs& a) {
-  if (a.positional.size() != 2)
-    throw InputError("hexrefine refine: expected IN and OUT (hexrefine refine --help)");
-  const std::string in = a.positional[0], out = a.positional[1];
+/// A key as the CLI writes it: `_` becomes `-`.
+std::string key_dashed(std::string_view key) {
+  std::string s(key);
+  std::replace(s.begin(), s.end(), '_', '-');
+  return s;
+}
+
+/// The table's options as `refine` spells them: `--max-edge-ratio R`, a flag that is on by
+/// default as `--no-ranking`, messages after "hexrefine refine: ".
+class CliRefineSpelling : public PipelineOptionSpelling {
+ public:
+  std::string name(std::string_view key) const override { return "--" + key_dashed(key); }
+  std::string subject(std::string_view key) const override {
+    return "hexrefine refine: " + name(key);
+  }
+  std::string setting(std::string_view key, const nlohmann::json& value) const override {
+    if (value.is_boolean()) {
+      if (value.get<bool>()) return name(key);
+      return pipeline_option_row(key)->default_value == true ? "--no-" + key_dashed(key)
+                                                             : "no " + name(key);
+    }
+    return name(key) + " " + (value.is_string() ? value.get<std::string>() : value.dump());
+  }
+  std::string value(const nlohmann::json& value) const override {
+    // Appended in steps: a chain of operator+ trips GCC 12's -Wrestrict false positive.
+    std::string text = "'";
+    text += value.is_string() ? value.get<std::string>() : value.dump();
+    text += "'";
+    return text;
+  }
+};
+
+/// The table's options as `refine`'s flags and help lines, in the table's order.
+std::vector<CliOption> refine_table_options() {
+  const CliRefineSpelling spelling;
+  std::vector<CliOption> out;
+  for (const PipelineOptionRow& row : pipeline_option_rows()) {
+    const std::string negation = "--no-" + key_dashed(row.key);
+    if (row.type == PipelineOptionType::flag) {
+      if (row.default_value == true)
+        out.push_back({negation, "", pipeline_option_text_spelt(row.off_help, spelling)});
+      else
+        out.push_back({spelling.name(row.key), "", pipeline_option_help_text(row, spelling)});
+      continue;
+    }
+    out.push_back({spelling.name(row.key), std::string(row.placeholder),
+                   pipeline_option_help_text(row, spelling)});
+    if (!row.off_value.empty())
+      out.push_back({negation, "",
+                     pipeline_option_text_spelt(row.off_help, spelling) + ", the same as " +
+                         spelling.setting(row.key, std::string(row.off_value))});
+  }
+  return out;
+}
+
+/// The settings the arguments give (pipeline_options_table.hpp): a flag's presence, a value's
+/// text as the row's type; a negation after its option (`--no-buffer` over `--buffer`).
+nlohmann::json refine_settings(const CliArgs& a) {
+  const CliRefineSpelling spelling;
+  nlohmann::json settings = nlohmann::json::object();
+  for (const PipelineOptionRow& row : pipeline_option_rows()) {
+    const std::string key(row.key), negation = "--no-" + key_dashed(row.key);
+    if (row.type == PipelineOptionType::flag) {
+      if (row.default_value == true ? a.flag(negation) : a.flag(spelling.name(key)))
+        settings[key] = !row.default_value.get<bool>();
+      continue;
+    }
+    if (const auto text = a.value(spelling.name(key)))
+      settings[key] = pipeline_option_value_from_text(row, *text, spelling);
+    if (!row.off_value.empty() && a.flag(negation)) settings[key] = std::string(row.off_value);
+  }
+  return settings;
+}
+
+}  // namespace
+
+PipelineOptions cli_refine_options(const CliArgs& a) {
   PipelineOptions o;
   const std::optional<std::string> method = a.value("--method");
   if (!method) throw InputError("hexrefine refine: --method " + methods_list() + " is required");
@@ -50,72 +129,18 @@ int refine_run(const CliArgs& a) {
   o.select = a.all("--select");
   if (o.select.empty())
     throw InputError("hexrefine refine: at least one --select SPEC (e.g. --select all)");
-  if (const auto p = a.value("--passes"))
-    o.refine.passes = static_cast<int>(cli_parse_int_in(*p, 1, 10, "--passes"));
-  if (const auto buffer = a.value("--buffer")) o.refine.buffer = pass_buffer_from_name(*buffer);
-  if (a.flag("--no-buffer")) o.refine.buffer = PassBuffer::none;
-  o.refine.ranking = !a.flag("--no-ranking");
-  if (const auto order = a.value("--directional-order")) {
-    if (*order == "by-rank")
-      o.refine.directional_order = DirectionalOrder::by_rank;
-    else if (*order == "by-hex")
-      o.refine.directional_order = DirectionalOrder::by_hex;
-    else
-      throw InputError("--directional-order: expected by-rank or by-hex, got '" + *order + "'");
-  }
-  o.refine.propagation = !a.flag("--no-propagation");
-  o.refine.ebe_only = a.flag("--ebe-only");
-  o.refine.allow_inverted = a.flag("--allow-inverted");
+  pipeline_options_set(o, refine_settings(a), CliRefineSpelling());
   o.refine.threads = cli_threads(a.value("--threads"));
-  if (const auto p = a.value("--placement")) {
-    if (*p == "trilinear")
-      o.refine.placement.method = PlacementMethod::trilinear;
-    else if (*p == "optimized")
-      o.refine.placement.method = PlacementMethod::optimized;
-    else if (*p == "untangle")
-      o.refine.placement.method = PlacementMethod::untangle;
-    else if (*p == "reference")
-      o.refine.placement.method = PlacementMethod::reference;
-    else
-      throw InputError(
-          "hexrefine refine: --placement must be trilinear, reference, optimized or untangle, "
-          "got '" +
-          *p + "'");
-  }
-  o.smooth = a.flag("--smooth");
-  if (!a.value("--placement")) o.refine.placement.method = pipeline_default_placement(o.smooth);
-  if (const auto r = a.value("--max-edge-ratio")) {
-    const double cap = cli_parse_double(*r, "hexrefine refine: --max-edge-ratio");
-    if (!(cap == 0 || (cap >= 1 && cap <= 1e6)))
-      throw InputError("hexrefine refine: --max-edge-ratio must be 0 or in 1..1e6, got '" + *r +
-                       "'");
-    o.refine.placement.max_edge_ratio = cap;
-    o.smoothing.max_edge_ratio = cap;
-  }
-  // The smoothing's budget: fewer sweeps and joint iterations trade quality for time
-  // (results/smoothing_budget.md measures the trade on the real-mesh study).
-  for (const char* option :
-       {"--smooth-sweeps", "--smooth-joint-iterations", "--smooth-joint-rounds"})
-    if (a.value(option) && !o.smooth)
-      throw InputError(std::string("hexrefine refine: ") + option + " needs --smooth");
-  o.smoothing_both_starts = a.flag("--smooth-both-starts");
-  if (o.smoothing_both_starts && !o.smooth)
-    throw InputError("hexrefine refine: --smooth-both-starts needs --smooth");
-  if (o.smoothing_both_starts && o.refine.placement.method != PlacementMethod::untangle)
-    throw InputError(
-        "hexrefine refine: --smooth-both-starts smooths from untangle and from optimized: it "
-        "takes no --placement but untangle");
-  if (const auto n = a.value("--smooth-sweeps"))
-    o.smoothing.max_sweeps =
-        static_cast<int>(cli_parse_int_in(*n, 1, 1000000, "hexrefine refine: --smooth-sweeps"));
-  if (const auto n = a.value("--smooth-joint-iterations"))
-    o.smoothing.joint_iterations = static_cast<int>(
-        cli_parse_int_in(*n, 0, 1000000, "hexrefine refine: --smooth-joint-iterations"));
-  if (const auto n = a.value("--smooth-joint-rounds"))
-    o.smoothing.joint_rounds =
-        static_cast<int>(cli_parse_int_in(*n, 1, 1000, "hexrefine refine: --smooth-joint-rounds"));
-  if (const auto m = a.value("--max-hexes"))
-    o.max_hexes = cli_parse_int_in(*m, 1, std::numeric_limits<int32_t>::max(), "--max-hexes");
+  return o;
+}
+
+namespace {
+
+int refine_run(const CliArgs& a) {
+  if (a.positional.size() != 2)
+    throw InputError("hexrefine refine: expected IN and OUT (hexrefine refine --help)");
+  const std::string in = a.positional[0], out = a.positional[1];
+  PipelineOptions o = cli_refine_options(a);
   if (a.flag("--verbose")) o.verbose = &std::cerr;
   // A progress line on long stages only where someone watches it.
   else if (::isatty(STDERR_FILENO))
@@ -157,6 +182,32 @@ int refine_run(const CliArgs& a) {
   return 0;
 }
 
+/// `refine`'s options: what to refine, the table's options, then the output's.
+std::vector<CliOption> refine_cli_options() {
+  std::vector<CliOption> out = {
+      {"--method", "M",
+       "refinement method: selective (Parrish's Selective Approach) or sheet "
+       "(Harris-style sheet refinement); required"},
+      {"--select", "SPEC",
+       "targets, united: all, hexes:FILE, box:..., sphere:cx,cy,cz,r, "
+       "boundary:nx,ny,nz[,deg], block:ID[,ID]",
+       true},
+  };
+  for (CliOption& option : refine_table_options()) out.push_back(std::move(option));
+  for (CliOption option : std::vector<CliOption>{
+           {"--binary", "", "binary instead of text output (.vtk: BINARY; .msh: Gmsh 4.1 binary)"},
+           {"--ascii", "", "VTU output as text instead of appended binary data (.vtu only)"},
+           {"--compress", "", "VTU output zlib-compressed (.vtu only)"},
+           {"--threads", "N",
+            "threads for the template application, node placement, smoothing, the check and the "
+            "write, 1..256 (same output; default: every core)"},
+           {"--report", "R.json", "write the JSON report (stats, checks, stage times)"},
+           {"--verbose", "", "print each stage's time on stderr as it ends"},
+       })
+    out.push_back(std::move(option));
+  return out;
+}
+
 }  // namespace
 
 const CliCommand cli_refine_command = {
@@ -164,62 +215,7 @@ const CliCommand cli_refine_command = {
     "IN OUT",
     "Refines the selected hexes of IN, places the new nodes, checks the result against IN and "
     "writes OUT.",
-    {
-        {"--method", "M",
-         "refinement method: selective (Parrish's Selective Approach) or sheet "
-         "(Harris-style sheet refinement); required"},
-        {"--select", "SPEC",
-         "targets, united: all, hexes:FILE, box:..., sphere:cx,cy,cz,r, "
-         "boundary:nx,ny,nz[,deg], block:ID[,ID]",
-         true},
-        {"--passes", "N", "refine the region N times, 1..10 (default 1)"},
-        {"--buffer", "RULE",
-         "selective, passes > 1: layer (default: one layer around the targets, the thesis' "
-         "H-2), transitions (every transition's children, cumulative) or none"},
-        {"--no-buffer", "", "ablation: the same as --buffer none"},
-        {"--placement", "P",
-         "new nodes: trilinear (the thesis' positions), reference (the templates' reference "
-         "positions, best on the unit cube, at trilinear's cost), optimized (the default without "
-         "--smooth: reference, then raise the worst scaled Jacobian where a child is still poor, "
-         "untangle) or untangle (trilinear, inverted children untangled: the default with "
-         "--smooth, the better start for it)"},
-        {"--smooth", "",
-         "smooth the refined region afterwards (checked again; starts from --placement untangle "
-         "unless a placement is given, and from optimized where untangle ends below plain "
-         "refine's minimum, with a warning; a smoothing the checker rejects is undone, with a "
-         "warning in the report)"},
-        {"--smooth-both-starts", "",
-         "--smooth: place by untangle and by optimized, smooth both, keep the higher minimum "
-         "(about twice the time; results/smoothing_starts.md)"},
-        {"--smooth-sweeps", "N",
-         "--smooth: at most N sweeps over the region's nodes before the joint ascent and N after "
-         "each of its rounds, 1..1000000 (default 20; fewer: faster, lower minimum)"},
-        {"--smooth-joint-iterations", "N",
-         "--smooth: at most N iterations per round of the joint ascent of the nodes around the "
-         "worst hexes (boundary nodes on the surface), 0..1000000 (default 1000; 0: the sweeps "
-         "alone)"},
-        {"--smooth-joint-rounds", "N",
-         "--smooth: at most N rounds of joint ascent and sweeps, each with a sharper soft "
-         "minimum, while a round raises the minimum, 1..1000 (default 3)"},
-        {"--max-edge-ratio", "R",
-         "optimized placement and --smooth give no hex an edge ratio above R or its ratio before "
-         "(default 20; 0: no cap, the scaled Jacobian alone)"},
-        {"--no-ranking", "", "ablation: selective without its ranking system"},
-        {"--directional-order", "ORDER",
-         "selective: by-hex (default: the thesis' hex after hex) or by-rank (a rank per step)"},
-        {"--no-propagation", "", "ablation: selective without its propagation scheme"},
-        {"--ebe-only", "", "ablation: element-by-element templates only"},
-        {"--allow-inverted", "", "refine an input with inverted hexes (no refusal, no verdict)"},
-        {"--max-hexes", "N", "refuse when n*27^passes could exceed N (default 2^31-1)"},
-        {"--binary", "", "binary instead of text output (.vtk: BINARY; .msh: Gmsh 4.1 binary)"},
-        {"--ascii", "", "VTU output as text instead of appended binary data (.vtu only)"},
-        {"--compress", "", "VTU output zlib-compressed (.vtu only)"},
-        {"--threads", "N",
-         "threads for the template application, node placement, smoothing, the check and the "
-         "write, 1..256 (same output; default: every core)"},
-        {"--report", "R.json", "write the JSON report (stats, checks, stage times)"},
-        {"--verbose", "", "print each stage's time on stderr as it ends"},
-    },
+    refine_cli_options(),
     "exit codes: 0 written, 1 the refinement failed (nothing written), 2 bad usage or input\n",
     refine_run,
 };

@@ -2,10 +2,10 @@
 /// The compiled part of the Python module `hexrefine` (pybind11): the same library as the command
 /// line, no second implementation. Meshes cross as numpy arrays (float64 n x 3 points, int32
 /// m x 8 hexes in VTK order, int32 per-hex attributes); refinement runs the one pipeline
-/// (algorithms/pipeline/pipeline.hpp) and returns its report as a dict with the CLI's keys. Long calls
-/// release the GIL. Errors: bad input -> ValueError (naming the hex, node or spec), a refinement
-/// that cannot be carried out -> hexrefine.RefinementError (a RuntimeError). The package around
-/// it (hexrefine/__init__.py) adds the meshio bridge.
+/// (algorithms/pipeline/pipeline.hpp) and returns its report as a dict with the CLI's keys. Long
+/// calls release the GIL. Errors: bad input -> ValueError (naming the hex, node or spec), a
+/// refinement that cannot be carried out -> hexrefine.RefinementError (a RuntimeError). The package
+/// around it (hexrefine/__init__.py) adds the meshio bridge.
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -16,6 +16,7 @@
 #include <string>
 
 #include "algorithms/pipeline/pipeline.hpp"
+#include "algorithms/pipeline/pipeline_options_table.hpp"
 #include "experiments/runner/runner.hpp"
 #include "mesh/conformity.hpp"
 #include "mesh/error.hpp"
@@ -122,6 +123,78 @@ py::dict attributes_dict(const HexMesh& m) {
 std::vector<std::string> specs_of(const py::object& spec) {
   if (py::isinstance<py::str>(spec)) return {spec.cast<std::string>()};
   return spec.cast<std::vector<std::string>>();
+}
+
+/// A JSON scalar as Python writes it: True, 'untangle', 20.
+std::string python_repr(const nlohmann::json& v) {
+  if (v.is_boolean()) return v.get<bool>() ? "True" : "False";
+  if (v.is_null()) return "None";
+  if (v.is_string()) return "'" + v.get<std::string>() + "'";
+  return v.dump();
+}
+
+/// The table's options as `hexrefine.refine`'s keywords: `smooth_sweeps`, `smooth=True`.
+class PythonSpelling : public PipelineOptionSpelling {
+ public:
+  std::string setting(std::string_view key, const nlohmann::json& value) const override {
+    return std::string(key) + "=" + python_repr(value);
+  }
+  std::string value(const nlohmann::json& value) const override { return python_repr(value); }
+};
+
+/// A keyword's value as a setting (pipeline_options_table.hpp): bool, int, float and str as
+/// themselves, numpy scalars as the Python value they hold, None as not given (null); anything
+/// else is a ValueError naming the keyword.
+nlohmann::json python_setting(const std::string& key, py::handle value) {
+  if (value.is_none()) return nullptr;
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>();
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  if (py::isinstance<py::int_>(value)) {
+    const py::int_ i = py::reinterpret_borrow<py::int_>(value);
+    if (i < py::int_(INT64_MIN) || i > py::int_(INT64_MAX))
+      throw InputError(key + " must be in range, got " + std::string(py::str(value)));
+    return i.cast<int64_t>();
+  }
+  if (py::isinstance<py::float_>(value)) return value.cast<double>();
+  if (py::hasattr(value, "dtype") && py::hasattr(value, "item"))
+    return python_setting(key, value.attr("item")());
+  throw InputError(key + ": expected a bool, a number or a string, got a " +
+                   std::string(py::str(value.get_type().attr("__name__"))));
+}
+
+/// The keywords as settings; an unknown one is a TypeError, as Python's own, with the one meant.
+nlohmann::json python_settings(const py::kwargs& keywords) {
+  nlohmann::json settings = nlohmann::json::object();
+  for (const auto& [k, v] : keywords) {
+    const std::string key = py::str(k);
+    if (!pipeline_option_row(key)) {
+      const std::string near = pipeline_option_key_closest(key);
+      throw py::type_error("refine() got an unexpected keyword argument '" + key + "'" +
+                           (near.empty() ? "" : " (did you mean " + near + "?)"));
+    }
+    settings[key] = python_setting(key, v);
+  }
+  return settings;
+}
+
+/// The table's rows as dicts (key, type, default, help in Python's spelling, values, range):
+/// hexrefine/__init__.py builds refine's signature and docstring from them.
+py::list python_option_rows() {
+  const PythonSpelling spelling;
+  static const char* const types[] = {"bool", "int", "float", "str"};
+  py::list rows;
+  for (const PipelineOptionRow& row : pipeline_option_rows()) {
+    py::dict d;
+    d["key"] = std::string(row.key);
+    d["type"] = types[static_cast<int>(row.type)];
+    d["default"] = json_to_python(row.default_value);
+    d["help"] = pipeline_option_help_text(row, spelling);
+    py::list values;
+    for (std::string_view v : row.values) values.append(std::string(v));
+    d["values"] = values;
+    rows.append(d);
+  }
+  return rows;
 }
 
 }  // namespace
@@ -232,12 +305,8 @@ PYBIND11_MODULE(_hexrefine, m) {
       "surface:RANK[,DEG].");
   m.def(
       "refine",
-      [](const HexMesh& mesh, const py::object& targets, const std::string& method, int passes,
-         const std::string& buffer, bool smooth, bool ranking, const std::string& directional_order,
-         bool propagation, bool ebe_only, const std::string& placement, int threads,
-         bool allow_inverted, int64_t max_hexes, double max_edge_ratio,
-         std::optional<int> smooth_sweeps, std::optional<int> smooth_joint_iterations,
-         std::optional<int> smooth_joint_rounds, bool smooth_both_starts) {
+      [](const HexMesh& mesh, const py::object& targets, const std::string& method, int threads,
+         const py::kwargs& keywords) {
         PipelineOptions o;
         o.method = method;
         if (py::isinstance<py::str>(targets) || py::isinstance<py::list>(targets) ||
@@ -270,63 +339,8 @@ PYBIND11_MODULE(_hexrefine, m) {
           std::sort(o.targets->begin(), o.targets->end());
           o.targets->erase(std::unique(o.targets->begin(), o.targets->end()), o.targets->end());
         }
-        o.refine.passes = passes;
-        o.refine.buffer = pass_buffer_from_name(buffer);
-        o.refine.ranking = ranking;
-        if (directional_order != "by_rank" && directional_order != "by_hex")
-          throw InputError("directional_order: expected 'by_rank' or 'by_hex', got '" +
-                           directional_order + "'");
-        o.refine.directional_order =
-            directional_order == "by_hex" ? DirectionalOrder::by_hex : DirectionalOrder::by_rank;
-        o.refine.propagation = propagation;
-        o.refine.ebe_only = ebe_only;
+        pipeline_options_set(o, python_settings(keywords), PythonSpelling());
         o.refine.threads = threads;
-        o.refine.allow_inverted = allow_inverted;
-        if (placement.empty())
-          o.refine.placement.method = pipeline_default_placement(smooth);
-        else if (placement == "trilinear")
-          o.refine.placement.method = PlacementMethod::trilinear;
-        else if (placement == "untangle")
-          o.refine.placement.method = PlacementMethod::untangle;
-        else if (placement == "reference")
-          o.refine.placement.method = PlacementMethod::reference;
-        else if (placement != "optimized")
-          throw InputError(
-              "placement must be 'trilinear', 'reference', 'optimized' or 'untangle', got '" +
-              placement + "'");
-        o.smooth = smooth;
-        if (!(max_edge_ratio == 0 || (max_edge_ratio >= 1 && max_edge_ratio <= 1e6)))
-          throw InputError("max_edge_ratio must be 0 or in 1..1e6, got " +
-                           std::to_string(max_edge_ratio));
-        o.refine.placement.max_edge_ratio = max_edge_ratio;
-        o.smoothing.max_edge_ratio = max_edge_ratio;
-        // As the CLI: a budget without smoothing is refused, not ignored.
-        if ((smooth_sweeps || smooth_joint_iterations || smooth_joint_rounds) && !smooth)
-          throw InputError(std::string(smooth_sweeps             ? "smooth_sweeps"
-                                       : smooth_joint_iterations ? "smooth_joint_iterations"
-                                                                 : "smooth_joint_rounds") +
-                           " needs smooth=True");
-        if (smooth_sweeps && (*smooth_sweeps < 1 || *smooth_sweeps > 1000000))
-          throw InputError("smooth_sweeps must be in 1..1000000, got " +
-                           std::to_string(*smooth_sweeps));
-        if (smooth_joint_iterations &&
-            (*smooth_joint_iterations < 0 || *smooth_joint_iterations > 1000000))
-          throw InputError("smooth_joint_iterations must be in 0..1000000, got " +
-                           std::to_string(*smooth_joint_iterations));
-        if (smooth_joint_rounds && (*smooth_joint_rounds < 1 || *smooth_joint_rounds > 1000))
-          throw InputError("smooth_joint_rounds must be in 1..1000, got " +
-                           std::to_string(*smooth_joint_rounds));
-        if (smooth_sweeps) o.smoothing.max_sweeps = *smooth_sweeps;
-        if (smooth_joint_rounds) o.smoothing.joint_rounds = *smooth_joint_rounds;
-        if (smooth_joint_iterations) o.smoothing.joint_iterations = *smooth_joint_iterations;
-        // As the CLI's --smooth-both-starts.
-        if (smooth_both_starts && !smooth) throw InputError("smooth_both_starts needs smooth=True");
-        if (smooth_both_starts && o.refine.placement.method != PlacementMethod::untangle)
-          throw InputError(
-              "smooth_both_starts smooths from untangle and from optimized: it takes no "
-              "placement but 'untangle'");
-        o.smoothing_both_starts = smooth_both_starts;
-        o.max_hexes = max_hexes;
         PipelineResult r;
         {
           py::gil_scoped_release release;
@@ -334,31 +348,20 @@ PYBIND11_MODULE(_hexrefine, m) {
         }
         return py::make_tuple(std::move(r.mesh), json_to_python(pipeline_report(r, o)));
       },
-      "mesh"_a, "targets"_a, "method"_a = "selective", "passes"_a = 1, "buffer"_a = "layer",
-      "smooth"_a = false, "ranking"_a = true, "directional_order"_a = "by_hex",
-      "propagation"_a = true, "ebe_only"_a = false, "placement"_a = "", "threads"_a = 1,
-      "allow_inverted"_a = false, "max_hexes"_a = int64_t{2147483647}, "max_edge_ratio"_a = 20.0,
-      "smooth_sweeps"_a = py::none(), "smooth_joint_iterations"_a = py::none(),
-      "smooth_joint_rounds"_a = py::none(), "smooth_both_starts"_a = false,
+      "mesh"_a, "targets"_a, "method"_a = "selective", "threads"_a = 1,
       "Refines `targets` (hex ids, or selection specs) by `method` through the pipeline: plan, "
-      "apply, place the new nodes (placement 'optimized', the thesis' 'trilinear', 'reference': "
-      "the templates' reference positions, or 'untangle': trilinear with inverted children "
-      "untangled, the better start for smooth=True; none given: 'untangle' with smooth=True, else "
-      "'optimized'), check "
-      "against the input, optionally smooth and check again. Returns (mesh, report): the mesh "
-      "with template_tag, refinement_level and parent_hex attributes, the report a dict with the "
-      "keys of `hexrefine refine --report`. `buffer` (passes > 1): 'layer' (the thesis' rule), "
-      "'transitions' or 'none'. `threads`: for the template application, node placement, "
-      "smoothing and the check (the same mesh for any count). `max_edge_ratio`: optimized "
-      "placement and smoothing give no hex an edge ratio above it or its ratio before (0: no "
-      "cap). `smooth_sweeps`, `smooth_joint_iterations`, `smooth_joint_rounds` (smooth=True "
-      "only; None: 20, 1000 and 3): the smoothing's budget (refine --smooth-sweeps, "
-      "--smooth-joint-iterations, --smooth-joint-rounds). `smooth_both_starts` (smooth=True, "
-      "no placement but 'untangle'): smooth from untangle and from optimized, keep the higher "
-      "minimum (refine --smooth-both-starts). "
-      "RefinementError if the method "
-      "refuses or the result "
-      "is invalid (unless an ablation switch or allow_inverted); ValueError for bad input.");
+      "apply, place the new nodes, check against the input, optionally smooth and check again. "
+      "Returns (mesh, report): the mesh with template_tag, refinement_level and parent_hex "
+      "attributes, the report a dict with the keys of `hexrefine refine --report`. `threads`: "
+      "for the template application, node placement, smoothing and the check (the same mesh for "
+      "any count). The other keywords are the pipeline's options (hexrefine.refine's signature "
+      "and docstring list them, from the one table of algorithms/pipeline/"
+      "pipeline_options_table.hpp); None: the default. RefinementError if the method refuses or "
+      "the result is invalid (unless an ablation switch or allow_inverted); ValueError for bad "
+      "input.");
+  m.def("refine_options", &python_option_rows,
+        "The pipeline's options, one dict per option (key, type, default, help, values): the "
+        "keywords of refine.");
   m.def(
       "check",
       [](const HexMesh& mesh, const HexMesh* reference) {

@@ -41,6 +41,10 @@ struct RunCase {
   std::vector<std::string> methods;       ///< each "selective" or "sheet", no repeats
   RefineOptions options;                  ///< passes and the "options" object
   bool smooth = false;
+  /// The case's pipeline options by the keys of algorithms/pipeline/pipeline_options_table.hpp
+  /// ("passes", "smooth" and the "options" object), checked: case_execute sets its
+  /// PipelineOptions from them; `options` and `smooth` are what they give (the record's key).
+  nlohmann::json settings = nlohmann::json::object();
   bool save_mesh = false;  ///< write each refined mesh as .vtu (for experiments/render_mesh.py)
   /// Set by run_plan_execute when save_mesh: the folder "<output stem>.meshes" beside the output.
   std::string save_mesh_dir;
@@ -181,9 +185,10 @@ RunSummary run_plan_execute(const RunPlan& plan, const RunSettings& settings,
                             const RunExecutor& execute);
 
 /// The real executor: builds or reads the mesh, then runs each method through the refinement
-/// pipeline (algorithms/pipeline/pipeline.hpp); the record is its report plus the input's description,
-/// wall and CPU seconds, and with save_mesh the file save_mesh_dir/run_mesh_file_name(case,
-/// method) (record: "mesh_file"). A refusal (OperationError) is a record with "error".
+/// pipeline (algorithms/pipeline/pipeline.hpp); the record is its report plus the input's
+/// description, wall and CPU seconds, and with save_mesh the file
+/// save_mesh_dir/run_mesh_file_name(case, method) (record: "mesh_file"). A refusal (OperationError)
+/// is a record with "error".
 void case_execute(const RunCase& c, const std::vector<std::string>& methods, const RunEmit& emit);
 
 /// "G-3/n=20", "selective" -> "G-3_n=20.selective.vtu": case names may hold '/'.

@@ -1,13 +1,14 @@
 /// \file
 /// case_execute: the runner's real executor. Builds (generate) or reads (file) the case's mesh
-/// once, then runs each method through the refinement pipeline (algorithms/pipeline/pipeline.hpp) on the
-/// same selection; the record is the pipeline's report plus what only the runner knows (the
+/// once, then runs each method through the refinement pipeline (algorithms/pipeline/pipeline.hpp)
+/// on the same selection; the record is the pipeline's report plus what only the runner knows (the
 /// input's description, wall and CPU time, the saved mesh).
 
 #include <chrono>
 #include <filesystem>
 
 #include "algorithms/pipeline/pipeline.hpp"
+#include "algorithms/pipeline/pipeline_options_table.hpp"
 #include "experiments/runner/runner.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"
@@ -43,10 +44,9 @@ void case_execute(const RunCase& c, const std::vector<std::string>& methods, con
 
   for (const std::string& method : methods) {
     PipelineOptions o;
+    pipeline_options_set(o, c.settings, PipelineOptionSpelling());
     o.method = method;
     o.select = c.select;
-    o.refine = c.options;
-    o.smooth = c.smooth;
     const auto start = std::chrono::steady_clock::now();
     PipelineResult r;
     try {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "algorithms/pipeline/pipeline.hpp"
+#include "algorithms/pipeline/pipeline_options_table.hpp"
 #include "experiments/runner/runner.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"
@@ -54,12 +55,6 @@ std::string schema_string(const json& j, const SchemaPath& p) {
   return j.get<std::string>();
 }
 
-int64_t schema_int(const json& j, const SchemaPath& p, int64_t min_value) {
-  if (!j.is_number_integer() || j.get<int64_t>() < min_value)
-    p.fail("expected an integer >= " + std::to_string(min_value));
-  return j.get<int64_t>();
-}
-
 bool schema_bool(const json& j, const SchemaPath& p) {
   if (!j.is_boolean()) p.fail("expected true or false");
   return j.get<bool>();
@@ -100,6 +95,70 @@ json parse_mesh(const json& j, const SchemaPath& p, const std::string& base_dir)
   return out;
 }
 
+/// The keys of the case's options that may also stand at the case's top level, where case
+/// files have always had them.
+constexpr const char* case_top_level_keys[] = {"passes", "smooth"};
+
+bool case_key_is_top_level(const json& j, std::string_view key) {
+  return std::find(std::begin(case_top_level_keys), std::end(case_top_level_keys), key) !=
+             std::end(case_top_level_keys) &&
+         j.contains(key);
+}
+
+/// The table's options (pipeline_options_table.hpp) as a case file spells them: keys as they
+/// are, messages "FILE: /cases/I/options/KEY: ...", a need naming the case.
+class CaseSpelling : public PipelineOptionSpelling {
+ public:
+  CaseSpelling(const SchemaPath& path, const std::string& name, const json& case_json)
+      : path_(path), name_(name), case_(case_json) {}
+  std::string subject(std::string_view key) const override {
+    const SchemaPath at = case_key_is_top_level(case_, key)
+                              ? path_.at(std::string(key))
+                              : path_.at("options").at(std::string(key));
+    return at.file + ": " + at.path;
+  }
+  std::string separator() const override { return ": "; }
+  std::string setting(std::string_view key, const json& value) const override {
+    return "\"" + std::string(key) + "\": " + value.dump();
+  }
+  std::string context() const override { return " (case '" + name_ + "')"; }
+
+ private:
+  const SchemaPath& path_;
+  const std::string& name_;
+  const json& case_;
+};
+
+/// The case's settings: "passes" and "smooth" from the case's top level or from "options",
+/// every other key of the table from "options" (others are unknown keys, listed). A boolean
+/// "buffer" of earlier case files means the rule it meant then (true: transitions, false: none).
+json case_settings(const json& j, const SchemaPath& p) {
+  json settings = json::object();
+  if (j.contains("options")) {
+    const json& o = j["options"];
+    const SchemaPath op = p.at("options");
+    schema_require_object(o, op);
+    for (const auto& [key, value] : o.items()) {
+      if (!pipeline_option_row(key)) {
+        std::string list;
+        for (const PipelineOptionRow& row : pipeline_option_rows())
+          list += (list.empty() ? "" : ", ") + std::string(row.key);
+        op.at(key).fail("unknown key (expected one of: " + list + ")");
+      }
+      settings[key] = value;
+    }
+  }
+  for (const char* key : case_top_level_keys)
+    if (j.contains(key)) {
+      if (settings.contains(key))
+        p.at(key).fail(std::string("given twice, here and in \"options\""));
+      settings[key] = j[key];
+    }
+  if (settings.contains("buffer") && settings["buffer"].is_boolean())
+    settings["buffer"] = settings["buffer"].get<bool>() ? "transitions" : "none";
+  return settings;
+}
+
 RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_dir, int index) {
   schema_require_object(j, p);
   schema_allow_keys(j, p,
@@ -134,62 +193,12 @@ RunCase parse_case(const json& j, const SchemaPath& p, const std::string& base_d
         p.at("methods").at(i).fail("method '" + c.methods[i] + "' listed twice");
     }
   }
-  if (j.contains("passes")) {
-    const int64_t passes = schema_int(j["passes"], p.at("passes"), 1);
-    if (passes > 10) p.at("passes").fail("expected an integer in [1, 10]");
-    c.options.passes = static_cast<int>(passes);
-  }
-  if (j.contains("smooth")) c.smooth = schema_bool(j["smooth"], p.at("smooth"));
   if (j.contains("save_mesh")) c.save_mesh = schema_bool(j["save_mesh"], p.at("save_mesh"));
-  if (j.contains("options")) {
-    const json& o = j["options"];
-    const SchemaPath op = p.at("options");
-    schema_require_object(o, op);
-    schema_allow_keys(o, op,
-                      {"ranking", "directional_order", "propagation", "ebe_only", "buffer",
-                       "allow_inverted", "placement"});
-    if (o.contains("ranking")) c.options.ranking = schema_bool(o["ranking"], op.at("ranking"));
-    if (o.contains("directional_order")) {
-      const std::string order = schema_string(o["directional_order"], op.at("directional_order"));
-      if (order != "by_rank" && order != "by_hex")
-        op.at("directional_order")
-            .fail("expected \"by_rank\" or \"by_hex\", got \"" + order + "\"");
-      c.options.directional_order =
-          order == "by_hex" ? DirectionalOrder::by_hex : DirectionalOrder::by_rank;
-    }
-    if (o.contains("propagation"))
-      c.options.propagation = schema_bool(o["propagation"], op.at("propagation"));
-    if (o.contains("ebe_only")) c.options.ebe_only = schema_bool(o["ebe_only"], op.at("ebe_only"));
-    if (o.contains("buffer")) {
-      // A rule name; the booleans of earlier case files mean what they meant then.
-      if (o["buffer"].is_boolean())
-        c.options.buffer = o["buffer"].get<bool>() ? PassBuffer::transitions : PassBuffer::none;
-      else
-        try {
-          c.options.buffer = pass_buffer_from_name(schema_string(o["buffer"], op.at("buffer")));
-        } catch (const InputError& e) {
-          op.at("buffer").fail(e.what());
-        }
-    }
-    if (o.contains("allow_inverted"))
-      c.options.allow_inverted = schema_bool(o["allow_inverted"], op.at("allow_inverted"));
-    if (o.contains("placement")) {
-      const std::string placement = schema_string(o["placement"], op.at("placement"));
-      if (placement == "trilinear")
-        c.options.placement.method = PlacementMethod::trilinear;
-      else if (placement == "optimized")
-        c.options.placement.method = PlacementMethod::optimized;
-      else if (placement == "untangle")
-        c.options.placement.method = PlacementMethod::untangle;
-      else if (placement == "reference")
-        c.options.placement.method = PlacementMethod::reference;
-      else
-        op.at("placement")
-            .fail("expected \"trilinear\", \"reference\", \"optimized\" or \"untangle\"");
-    }
-  }
-  if (!j.contains("options") || !j["options"].contains("placement"))
-    c.options.placement.method = pipeline_default_placement(c.smooth);
+  c.settings = case_settings(j, p);
+  PipelineOptions options;
+  pipeline_options_set(options, c.settings, CaseSpelling(p, c.name, j));
+  c.options = options.refine;
+  c.smooth = options.smooth;
   if (j.contains("expect")) {
     // "refused" for every method of the case, or {"METHOD": "refused", ...} for listed methods.
     const json& e = j["expect"];

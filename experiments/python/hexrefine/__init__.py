@@ -17,11 +17,38 @@ that cannot be carried out raises RefinementError (a RuntimeError). Long calls r
 meshio is optional: it is imported only by from_meshio and to_meshio.
 """
 
-from ._hexrefine import (HexMesh, RefinementError, check, generate, methods, quality, read, refine,
-                         run, select, write)
+import inspect
+
+from . import _hexrefine
+from ._hexrefine import (HexMesh, RefinementError, check, generate, methods, quality, read,
+                         refine_options, run, select, write)
 
 __all__ = ["HexMesh", "RefinementError", "check", "from_meshio", "generate", "methods", "quality", "read",
-           "refine", "run", "select", "to_meshio", "write"]
+           "refine", "refine_options", "run", "select", "to_meshio", "write"]
+
+
+def refine(mesh, targets, method="selective", threads=1, **options):
+    # The signature and the docstring are set below from the options table.
+    return _hexrefine.refine(mesh, targets, method, threads, **options)
+
+
+def _refine_signature_and_doc():
+    """refine's keywords and their help, from the pipeline's one table of options
+    (algorithms/pipeline/pipeline_options_table.hpp, through refine_options()): a default that
+    depends on another option (placement) shows as None."""
+    parameter = inspect.Parameter
+    parameters = [parameter("mesh", parameter.POSITIONAL_OR_KEYWORD),
+                  parameter("targets", parameter.POSITIONAL_OR_KEYWORD),
+                  parameter("method", parameter.POSITIONAL_OR_KEYWORD, default="selective"),
+                  parameter("threads", parameter.POSITIONAL_OR_KEYWORD, default=1)]
+    lines = [_hexrefine.refine.__doc__.split("\n\n", 1)[-1].strip(), "", "Options:"]
+    for row in refine_options():
+        parameters.append(parameter(row["key"], parameter.KEYWORD_ONLY, default=row["default"]))
+        lines.append("  %s (%s): %s" % (row["key"], row["type"], row["help"]))
+    return inspect.Signature(parameters), "\n".join(lines)
+
+
+refine.__signature__, refine.__doc__ = _refine_signature_and_doc()
 
 
 def from_meshio(m):

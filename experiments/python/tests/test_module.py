@@ -203,7 +203,8 @@ def test_threads_give_the_same_placed_and_smoothed_mesh():
     assert both["check"]["valid"]
     with pytest.raises(ValueError, match="smooth_both_starts needs smooth=True"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth_both_starts=True)
-    with pytest.raises(ValueError, match="takes no placement but 'untangle'"):
+    with pytest.raises(ValueError, match="smooth_both_starts needs placement='untangle', got "
+                                         "placement='optimized'"):
         hexrefine.refine(mesh, "sphere:0,0,0,5", smooth=True, placement="optimized",
                          smooth_both_starts=True)
 
@@ -312,6 +313,42 @@ def test_run_yields_the_records_of_the_command_line(tmp_path):
     assert all(r["check"]["valid"] for r in records)
     lines = (tmp_path / "out.jsonl").read_text().splitlines()
     assert len(lines) == 2
+
+
+def test_refine_keywords_are_the_options_table(brick10, tmp_path):
+    """refine's keywords, their defaults and checks are the pipeline's one table: the same
+    settings as keywords and as a case's options give the same options and the same mesh."""
+    import inspect
+    keys = [row["key"] for row in hexrefine.refine_options()]
+    assert keys[:4] == ["passes", "buffer", "placement", "smooth"] and "max_edge_ratio" in keys
+    signature = inspect.signature(hexrefine.refine)
+    assert list(signature.parameters)[:4] == ["mesh", "targets", "method", "threads"]
+    for row in hexrefine.refine_options():
+        assert signature.parameters[row["key"]].default == row["default"]
+        assert row["key"] + " (" in hexrefine.refine.__doc__
+    settings = {"passes": 2, "buffer": "transitions", "ranking": False,
+                "directional_order": "by_rank", "max_edge_ratio": 0, "placement": "trilinear"}
+    refined, report = hexrefine.refine(brick10, L_SHAPE, **settings)
+    cases = {"cases": [{"name": "same", "mesh": {"generate": "brick", "dims": [10, 10, 10]},
+                        "select": L_SHAPE, "methods": ["selective"], "options": settings}]}
+    record, = hexrefine.run(cases, str(tmp_path / "out.jsonl"))
+    options = dict(report["options"])
+    del options["threads"]
+    assert record["options"] == options
+    assert record["refine"]["final_hexes"] == refined.hex_count
+    # numpy scalars are the values they hold; None is the default.
+    _, same = hexrefine.refine(brick10, L_SHAPE, passes=np.int64(2), buffer="transitions",
+                               ranking=np.bool_(False), directional_order="by_rank",
+                               max_edge_ratio=np.float64(0), placement="trilinear",
+                               smooth_sweeps=None)
+    assert same["options"] == report["options"]
+    with pytest.raises(TypeError, match="did you mean smooth_sweeps"):
+        hexrefine.refine(brick10, L_SHAPE, smooth_sweep=2)
+    with pytest.raises(ValueError, match=r"directional_order must be by_hex or by_rank, got "
+                                         r"'by-rank' \(did you mean by_rank\?"):
+        hexrefine.refine(brick10, L_SHAPE, directional_order="by-rank")
+    with pytest.raises(ValueError, match="passes must be an integer, got '2'"):
+        hexrefine.refine(brick10, L_SHAPE, passes="2")
 
 
 def test_ablation_example_runs_and_writes_its_records(tmp_path):

@@ -36,7 +36,7 @@ TEST(CliRefine, DirectionalOrderAndBufferRuleOptions) {
   // Table H-2 with the thesis' defaults (hex after hex, the layer buffer): 370,304 hexes.
   CliRun r = cli_run(join({"refine", in, out,
                            "--method selective --select boundary:-1,0,0 --passes 3 "
-                           "--placement trilinear --directional-order by-rank --report",
+                           "--placement trilinear --directional-order by_rank --report",
                            (dir / "r.json").string()}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   nlohmann::json j = read_json(dir / "r.json");
@@ -59,6 +59,14 @@ TEST(CliRefine, DirectionalOrderAndBufferRuleOptions) {
                           "--method selective --select all --directional-order sideways"}))
                 .exit_code,
             2);
+  // One spelling per value, the report's: the CLI's former `by-rank` is refused with the one meant.
+  const CliRun dashed = cli_run(
+      join({"refine", in, out, "--method selective --select all --directional-order by-rank"}));
+  EXPECT_EQ(dashed.exit_code, 2);
+  EXPECT_NE(dashed.output.find("hexrefine refine: --directional-order must be by_hex or by_rank, "
+                               "got 'by-rank' (did you mean by_rank?"),
+            std::string::npos)
+      << dashed.output;
 }
 
 TEST(CliRefine, LShapedCaseWritesMeshAndReport) {
@@ -331,7 +339,9 @@ TEST(CliRefine, SmoothingBudgetTradesQualityForTime) {
   const CliRun both_placed =
       cli_run(join({rocker, "--smooth --smooth-both-starts --placement optimized"}));
   EXPECT_EQ(both_placed.exit_code, 2);
-  EXPECT_NE(both_placed.output.find("takes no --placement but untangle"), std::string::npos)
+  EXPECT_NE(both_placed.output.find("hexrefine refine: --smooth-both-starts needs --placement "
+                                    "untangle, got --placement optimized"),
+            std::string::npos)
       << both_placed.output;
 }
 

@@ -144,7 +144,7 @@ TEST(RunPlan, SchemaErrorsNameFileAndJsonPath) {
   json c = brick_case("a");
   c["passes"] = 0;
   EXPECT_EQ(error_of(json{{"cases", {brick_case("z"), c}}}),
-            "cases.json: /cases/1/passes: expected an integer >= 1");
+            "cases.json: /cases/1/passes: must be in 1..10, got 0");
   c = brick_case("a");
   c["methods"] = {"selective", "octree"};
   EXPECT_EQ(error_of(json{{"cases", {c}}}),
@@ -157,8 +157,8 @@ TEST(RunPlan, SchemaErrorsNameFileAndJsonPath) {
   c = brick_case("a");
   c["options"] = {{"placement", "smooth"}};
   EXPECT_EQ(error_of(json{{"cases", {c}}}),
-            "cases.json: /cases/0/options/placement: expected \"trilinear\", \"reference\", "
-            "\"optimized\" or \"untangle\"");
+            "cases.json: /cases/0/options/placement: must be trilinear, reference, optimized or "
+            "untangle, got \"smooth\"");
   c = brick_case("a");
   c["mesh"]["radius"] = 1.0;
   EXPECT_NE(error_of(json{{"cases", {c}}})
@@ -172,7 +172,7 @@ TEST(RunPlan, SchemaErrorsNameFileAndJsonPath) {
   c = brick_case("a");
   c["options"] = {{"ranking", 1}};
   EXPECT_EQ(error_of(json{{"cases", {c}}}),
-            "cases.json: /cases/0/options/ranking: expected true or false");
+            "cases.json: /cases/0/options/ranking: must be true or false, got 1");
   c = brick_case("a");
   c["mesh"] = {{"file", "nowhere.mesh"}};
   EXPECT_EQ(error_of(json{{"cases", {c}}}),
@@ -186,6 +186,63 @@ TEST(RunPlan, SchemaErrorsNameFileAndJsonPath) {
   EXPECT_NE(error_of(json{{"cases", {c}}}).find("/cases/0: missing \"select\""), std::string::npos);
   EXPECT_EQ(error_of(json{{"cases", {brick_case("a"), brick_case("a")}}}),
             "cases.json: /cases/1/name: case name 'a' used twice");
+}
+
+TEST(RunPlan, CaseOptionsAreTheTablesKeysWithTheirChecks) {
+  auto error_of = [](const json& c) {
+    return input_error_of([&] { run_plan_parse(json{{"cases", {c}}}, "cases.json", "/n"); });
+  };
+  // Every key of the options table, "passes" and "smooth" also at the top level.
+  json c = brick_case("a");
+  c["smooth"] = true;
+  c["options"] = {
+      {"passes", 2},         {"smooth_sweeps", 5},        {"smooth_joint_rounds", 1},
+      {"max_edge_ratio", 0}, {"buffer", false},           {"directional_order", "by_rank"},
+      {"max_hexes", 100000}, {"smooth_both_starts", true}};
+  const RunPlan plan = run_plan_parse(json{{"cases", {c}}}, "cases.json", "/n");
+  const RunCase& a = plan.cases[0];
+  EXPECT_EQ(a.options.passes, 2);
+  EXPECT_TRUE(a.smooth);
+  EXPECT_EQ(a.options.buffer, PassBuffer::none);  // the boolean of earlier case files
+  EXPECT_EQ(a.options.directional_order, DirectionalOrder::by_rank);
+  EXPECT_EQ(a.options.placement.max_edge_ratio, 0);
+  EXPECT_EQ(a.options.placement.method, PlacementMethod::untangle);  // the default with smooth
+  EXPECT_EQ(a.settings["smooth_sweeps"], 5);
+  EXPECT_EQ(a.settings["buffer"], "none");
+  EXPECT_EQ(a.settings["smooth"], true);
+  // The checks the CLI makes, naming the case and the key.
+  c = brick_case("b");
+  c["options"] = {{"smooth_sweeps", 5}};
+  EXPECT_EQ(error_of(c),
+            "cases.json: /cases/0/options/smooth_sweeps: needs \"smooth\": true (case 'b')");
+  c["smooth"] = false;
+  EXPECT_EQ(error_of(c),
+            "cases.json: /cases/0/options/smooth_sweeps: needs \"smooth\": true (case 'b')");
+  c = brick_case("b");
+  c["smooth"] = true;
+  c["options"] = {{"smooth_both_starts", true}, {"placement", "trilinear"}};
+  EXPECT_EQ(error_of(c),
+            "cases.json: /cases/0/options/smooth_both_starts: needs \"placement\": \"untangle\", "
+            "got \"placement\": \"trilinear\" (it smooths from untangle and from optimized itself) "
+            "(case 'b')");
+  c = brick_case("b");
+  c["options"] = {{"smooth_joint_rounds", 1001}};
+  EXPECT_EQ(error_of(c),
+            "cases.json: /cases/0/options/smooth_joint_rounds: must be in 1..1000, got 1001");
+  c["options"] = {{"directional_order", "by-rank"}};
+  EXPECT_NE(error_of(c).find("/cases/0/options/directional_order: must be by_hex or by_rank, got "
+                             "\"by-rank\" (did you mean by_rank?"),
+            std::string::npos);
+  c["options"] = {{"smooth_sweep", 5}};
+  EXPECT_NE(error_of(c).find("/cases/0/options/smooth_sweep: unknown key (expected one of: "
+                             "passes, buffer, placement, smooth,"),
+            std::string::npos);
+  c["options"] = {{"passes", 2}};
+  c["passes"] = 2;
+  EXPECT_EQ(error_of(c), "cases.json: /cases/0/passes: given twice, here and in \"options\"");
+  c.erase("options");
+  c["passes"] = 11;
+  EXPECT_EQ(error_of(c), "cases.json: /cases/0/passes: must be in 1..10, got 11");
 }
 
 TEST(RunPlan, ReadReportsSyntaxErrorLine) {

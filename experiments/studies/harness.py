@@ -50,6 +50,14 @@ def study_arguments(description, out=RESULTS, hexrefine=False, report_only=False
     return parser
 
 
+def run_command_study(description, command):
+    """The run.py of a study the command runs itself (`hexrefine reproduce`, `hexrefine study`):
+    --hexrefine, every other argument passed on to `hexrefine COMMAND`; exits with its status."""
+    parser = study_arguments(description, out=None, hexrefine=True)
+    args, rest = parser.parse_known_args()
+    sys.exit(subprocess.run([args.hexrefine, command] + rest).returncode)
+
+
 def first_line(docstring):
     """The first line of a module docstring, for study_arguments' description."""
     return docstring.strip().split("\n")[0]
@@ -142,8 +150,9 @@ def schema_versions(versions):
 def write_text_atomic(path, text):
     """Writes `text` (UTF-8) to a temporary file in `path`'s folder (named after the process id,
     so two runs do not share it), then renames it onto `path`: a reader sees the old file or
-    the new one, never a part."""
+    the new one, never a part. Creates the folder if it is missing."""
     path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(".%s.%d.tmp" % (path.name, os.getpid()))
     try:
         tmp.write_text(text, encoding="utf-8")
@@ -171,6 +180,7 @@ def savefig_atomic(fig, path, dpi):
     import matplotlib.pyplot as plt
 
     path = str(path)
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     tmp = path + ".tmp.png"
     fig.savefig(tmp, dpi=dpi)
     plt.close(fig)

@@ -93,6 +93,27 @@ def optimized_cases(script, path, max_output_hexes):
     return cases
 
 
+def smoothed_case_figures(report, unsmoothed_edge_ratio=True):
+    """What edge_ratio_cap and smooth_start record of a `refine --smooth` report, in their
+    records' key order: the refined parents' minimum, the refined (unsmoothed) and the smoothed
+    output's minimum scaled Jacobian, the largest edge ratio (the unsmoothed one only with
+    `unsmoothed_edge_ratio`), both valid, the refine and smooth stages' seconds, and the report's
+    schema version."""
+    check = harness.report_refined_check(report)
+    smoothed = harness.report_output_check(report)
+    figures = {"parents_min": report["refined_parents"]["min_scaled_jacobian"],
+               "min": check["min_scaled_jacobian"],
+               "smoothed_min": smoothed["min_scaled_jacobian"]}
+    if unsmoothed_edge_ratio:
+        figures["edge_ratio"] = check["max_edge_ratio"]
+    figures.update(smoothed_edge_ratio=smoothed["max_edge_ratio"],
+                   valid=check["valid"] and smoothed["valid"],
+                   refine_s=report["stage_seconds"]["refine"],
+                   smooth_s=report["stage_seconds"].get("smooth", 0.0),
+                   schema_version=harness.report_schema_version(report))
+    return figures
+
+
 def fmt(value, digits=3):
     """A number for these studies' tables: thousands separators for integers, `digits`
     significant digits otherwise, "–" for None."""

@@ -143,7 +143,6 @@ def main():
     record["load_average_after"] = load_average()
     record["schema_version"] = harness.schema_versions(versions)
     out_dir = pathlib.Path(args.out)
-    out_dir.mkdir(parents=True, exist_ok=True)
     harness.write_json_atomic(out_dir / "checker.json", record)
     harness.write_text_atomic(out_dir / "checker.md", markdown(record))
     print(markdown(record))

@@ -17,11 +17,9 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent))
 import harness  # noqa: E402
-from real_mesh_cases import fmt, optimized_cases_with_meshes  # noqa: E402
+from real_mesh_cases import fmt, optimized_cases_with_meshes, smoothed_case_figures  # noqa: E402,E501
 
 CAPS = [0, 10, 20, 30]
-
-
 SCRIPT = "edge_ratio_cap/run.py"
 
 
@@ -34,20 +32,8 @@ def main():
             _, report = hexrefine.refine(mesh, case["specs"], method=case["method"],
                                          passes=case["passes"], buffer=case["buffer"],
                                          smooth=True, max_edge_ratio=cap)
-            check = harness.report_refined_check(report)
-            smoothed = harness.report_output_check(report)
-            records.append(dict(case, cap=cap,
-                                parents_min=report["refined_parents"]["min_scaled_jacobian"],
-                                min=check["min_scaled_jacobian"],
-                                smoothed_min=smoothed["min_scaled_jacobian"],
-                                edge_ratio=check["max_edge_ratio"],
-                                smoothed_edge_ratio=smoothed["max_edge_ratio"],
-                                valid=check["valid"] and smoothed["valid"],
-                                refine_s=report["stage_seconds"]["refine"],
-                                smooth_s=report["stage_seconds"].get("smooth", 0.0),
-                                schema_version=harness.report_schema_version(report)))
+            records.append(dict(case, cap=cap, **smoothed_case_figures(report)))
     out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     harness.write_json_atomic(out / "edge_ratio_cap.json", records)
 
     lines = ["# Edge-ratio cap: what the scaled Jacobian gains by collapsing edges\n",

@@ -133,7 +133,6 @@ def main():
                                               record["min"], record["refine_cpu_s"])),
                   flush=True)
     out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     harness.write_json_atomic(out / "placement.json", dict(
         harness.provenance(schema_version=versions), records=records,
         seconds=time.time() - started))

@@ -12,18 +12,10 @@ report alone, on records at hand: python3 experiments/studies/real_meshes/report
 """
 
 import pathlib
-import subprocess
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent))
 import harness  # noqa: E402
 
-
-def main():
-    parser = harness.study_arguments(harness.first_line(__doc__), out=None, hexrefine=True)
-    args, rest = parser.parse_known_args()
-    sys.exit(subprocess.run([args.hexrefine, "study"] + rest).returncode)
-
-
 if __name__ == "__main__":
-    main()
+    harness.run_command_study(harness.first_line(__doc__), "study")

@@ -17,7 +17,7 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent))
 import harness  # noqa: E402
-from real_mesh_cases import fmt, optimized_cases_with_meshes  # noqa: E402
+from real_mesh_cases import fmt, optimized_cases_with_meshes, smoothed_case_figures  # noqa: E402,E501
 
 PLACEMENTS = ["optimized", "untangle", "trilinear"]
 SCRIPT = "smooth_start/run.py"
@@ -39,19 +39,9 @@ def main():
                 record["refused"] = str(error).splitlines()[0][:200]
                 records.append(record)
                 continue
-            check = harness.report_refined_check(report)
-            smoothed = harness.report_output_check(report)
-            record.update(parents_min=report["refined_parents"]["min_scaled_jacobian"],
-                          min=check["min_scaled_jacobian"],
-                          smoothed_min=smoothed["min_scaled_jacobian"],
-                          smoothed_edge_ratio=smoothed["max_edge_ratio"],
-                          valid=check["valid"] and smoothed["valid"],
-                          refine_s=report["stage_seconds"]["refine"],
-                          smooth_s=report["stage_seconds"].get("smooth", 0.0),
-                          schema_version=harness.report_schema_version(report))
+            record.update(smoothed_case_figures(report, unsmoothed_edge_ratio=False))
             records.append(record)
     out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     harness.write_json_atomic(out / "smooth_start.json", records)
 
     lines = ["# Which placement to smooth from\n",

@@ -314,7 +314,7 @@ def test_run_yields_the_records_of_the_command_line(tmp_path):
 
 def test_ablation_example_runs_and_writes_its_records(tmp_path):
     script = pathlib.Path(os.environ.get("HEXREFINE_SOURCE_DIR", ".")) / "experiments" / \
-        "examples" / "ablation.py"
+        "studies" / "ablation" / "run.py"
     out = tmp_path / "ablation.json"
     subprocess.run([sys.executable, str(script), "--quick", "--seeds", "2", "--placement",
                     "trilinear", "--json", str(out)], check=True, capture_output=True)

@@ -196,123 +196,23 @@ double weight(double z) {
   return z < 40.0 ? std::exp(-z) : 0.0;
 }
 
+/// The objective of one joint ascent (step 1 of the file comment: its variables and hexes) and
+/// its evaluation (step 2); nodes_ascend_jointly runs steps 3 and 4 on it.
+/// Length: a class, not a function; its methods are short, kept in one class because the
+/// evaluation and its gradient share the per-hex buffers the constructor sizes.
 class JointProblem {
  public:
   JointProblem(HexMesh& mesh, const NodeProblem& problem, const JointAscentOptions& options)
       : mesh_(mesh), problem_(problem), options_(options) {
-    // With options.slide the sliding nodes are variables like the free ones.
-    // A slide without items (none is built so, but a caller could) would move freely: left out.
-    const auto moves = [&](int32_t i) {
-      if (i < 0) return false;
-      const NodeSlide& slide = problem.slides[i];
-      return slide.kind == SlideKind::free || (options.slide && slide.count > 0);
-    };
-    const int32_t n = static_cast<int32_t>(problem.nodes.size());
-    // The variables: the moving nodes of the worst hexes within options.band of the worst sample
-    // a variable moves, and of `rings` rings of hexes around them.
-    std::vector<uint8_t> chosen(n, 0);
-    // Per problem hex its worst sample that a variable moves (2: none, never a seed).
-    std::vector<double> quality(problem.hexes.size(), 2.0);
-    double worst = 1.0;
-    for (size_t j = 0; j < problem.hexes.size(); ++j) {
-      std::array<bool, 8> moving{};
-      for (int c = 0; c < 8; ++c) moving[c] = moves(problem.hex_local_nodes[j][c]);
-      const uint16_t mask = sample_mask(moving);
-      if (!mask) continue;
-      std::array<double, 9> samples;
-      hex_scaled_jacobian_samples(hex_points(mesh_, problem.hexes[j]), samples);
-      for (int k = 0; k < 9; ++k)
-        if (mask >> k & 1) quality[j] = std::min(quality[j], samples[k]);
-      worst = std::min(worst, quality[j]);
-    }
-    // The seeds: within the band, at most max_seeds of them, the worst first (ties by index).
-    std::vector<std::pair<double, int32_t>> seeds;
-    for (size_t j = 0; j < problem.hexes.size(); ++j)
-      if (quality[j] <= 1.0 && quality[j] < worst + options.band)
-        seeds.push_back({quality[j], static_cast<int32_t>(j)});
-    if (static_cast<int64_t>(seeds.size()) > options.max_seeds) {
-      std::nth_element(seeds.begin(), seeds.begin() + options.max_seeds, seeds.end());
-      seeds.resize(static_cast<size_t>(options.max_seeds));
-    }
-    std::vector<int32_t> front;
-    for (const auto& [unused, j] : seeds) {
-      for (int32_t i : problem.hex_local_nodes[j])
-        if (i >= 0 && !chosen[i]) chosen[i] = 1, front.push_back(i);
-    }
-    for (int ring = 0; ring < options.rings; ++ring) {
-      std::vector<int32_t> next;
-      for (int32_t i : front)
-        for (int32_t k = problem.node_hex_offsets[i]; k < problem.node_hex_offsets[i + 1]; ++k)
-          for (int32_t j : problem.hex_local_nodes[problem.node_hex[k]])
-            if (j >= 0 && !chosen[j]) chosen[j] = 1, next.push_back(j);
-      front.swap(next);
-    }
-    std::vector<int32_t> var_of(n, -1);
-    for (int32_t i = 0; i < n; ++i)
-      if (chosen[i] && moves(i)) {
-        var_of[i] = static_cast<int32_t>(nodes_.size());
-        nodes_.push_back(problem.nodes[i]);
-        var_problem_.push_back(i);
-        if (problem.slides[i].kind != SlideKind::free) sliding_.push_back(var_of[i]);
-      }
-    // The boundary faces of the sliding variables, each once: an accepted step keeps them on
-    // the reference surface (NodeProblem::surface), or the line search cuts it.
-    if (problem.surface && !problem.node_face_offsets.empty()) {
-      for (int32_t v : sliding_)
-        for (int32_t k = problem.node_face_offsets[var_problem_[v]];
-             k < problem.node_face_offsets[var_problem_[v] + 1]; ++k)
-          guard_faces_.push_back(problem.node_face[k]);
-      std::sort(guard_faces_.begin(), guard_faces_.end());
-      guard_faces_.erase(std::unique(guard_faces_.begin(), guard_faces_.end()), guard_faces_.end());
-    }
+    const std::vector<int32_t> var_of = variables_choose();
+    sliding_guard_faces_collect();
     // Where each sliding variable is on its slide: the projections' warm starts.
     states_.resize(sliding_.size());
     for (size_t k = 0; k < sliding_.size(); ++k)
       hexrefine::slide_project(problem.slides[var_problem_[sliding_[k]]], problem.geometry,
                                mesh_.points[nodes_[sliding_[k]]], states_[k]);
-    for (size_t j = 0; j < problem.hexes.size(); ++j) {
-      std::array<int32_t, 8> vars;
-      bool any = false;
-      for (int c = 0; c < 8; ++c) {
-        const int32_t i = problem.hex_local_nodes[j][c];
-        vars[c] = i >= 0 ? var_of[i] : -1;
-        any = any || vars[c] >= 0;
-      }
-      if (!any) continue;
-      std::array<bool, 8> corner_moves;
-      for (int c = 0; c < 8; ++c) corner_moves[c] = vars[c] >= 0;
-      hexes_.push_back(problem.hexes[j]);
-      edge_caps_.push_back(
-          hex_edge_ratio_cap(hex_points(mesh_, problem.hexes[j]), options.max_edge_ratio));
-      hex_vars_.push_back(vars);
-      masks_.push_back(sample_mask(corner_moves));
-    }
-    // Variable -> (objective hex, corner), CSR, in hex order.
-    var_offsets_.assign(nodes_.size() + 1, 0);
-    for (const auto& vars : hex_vars_)
-      for (int32_t v : vars)
-        if (v >= 0) ++var_offsets_[v + 1];
-    for (size_t v = 0; v < nodes_.size(); ++v) var_offsets_[v + 1] += var_offsets_[v];
-    var_items_.resize(var_offsets_.back());
-    std::vector<int32_t> cursor(var_offsets_.begin(), var_offsets_.end() - 1);
-    for (size_t h = 0; h < hex_vars_.size(); ++h)
-      for (int c = 0; c < 8; ++c)
-        if (hex_vars_[h][c] >= 0) var_items_[cursor[hex_vars_[h][c]]++] = {int32_t(h), c};
-    samples_.resize(hexes_.size());
-    cap_samples_.assign(hexes_.size(), std::numeric_limits<double>::infinity());
-    hex_gradient_.resize(hexes_.size());
-    const int64_t chunks = parallel_chunk_count(static_cast<int64_t>(hexes_.size()), chunk_hexes);
-    chunk_min_.resize(chunks);
-    chunk_cap_min_.resize(chunks);
-    chunk_sum_.resize(chunks);
-    double edges = 0;
-    for (int32_t h : hexes_) {
-      const Corners p = hex_points(mesh_, h);
-      for (const auto& e : hex_edges) edges += (p[e[1]] - p[e[0]]).norm();
-    }
-    mean_edge_ = hexes_.empty() ? 0.0 : edges / (12.0 * static_cast<double>(hexes_.size()));
-    // Threads start per evaluation: below a few thousand hexes that costs more than it saves.
-    threads_ = hexes_.size() < 8 * chunk_hexes ? 1 : std::max(options.threads, 1);
+    objective_hexes_build(var_of);
+    evaluation_buffers_size();
   }
 
   int64_t variables() const { return static_cast<int64_t>(nodes_.size()) * 3; }
@@ -488,6 +388,135 @@ class JointProblem {
   }
 
  private:
+  /// The variables (nodes_, var_problem_, sliding_): the moving nodes of the worst hexes within
+  /// options.band of the worst sample a variable moves (at most max_seeds of them), and of
+  /// `rings` rings of hexes around them. Returns per problem node its variable (-1: none).
+  std::vector<int32_t> variables_choose() {
+    const NodeProblem& problem = problem_;
+    const JointAscentOptions& options = options_;
+    // With options.slide the sliding nodes are variables like the free ones.
+    // A slide without items (none is built so, but a caller could) would move freely: left out.
+    const auto moves = [&](int32_t i) {
+      if (i < 0) return false;
+      const NodeSlide& slide = problem.slides[i];
+      return slide.kind == SlideKind::free || (options.slide && slide.count > 0);
+    };
+    const int32_t n = static_cast<int32_t>(problem.nodes.size());
+    std::vector<uint8_t> chosen(n, 0);
+    // Per problem hex its worst sample that a variable moves (2: none, never a seed).
+    std::vector<double> quality(problem.hexes.size(), 2.0);
+    double worst = 1.0;
+    for (size_t j = 0; j < problem.hexes.size(); ++j) {
+      std::array<bool, 8> moving{};
+      for (int c = 0; c < 8; ++c) moving[c] = moves(problem.hex_local_nodes[j][c]);
+      const uint16_t mask = sample_mask(moving);
+      if (!mask) continue;
+      std::array<double, 9> samples;
+      hex_scaled_jacobian_samples(hex_points(mesh_, problem.hexes[j]), samples);
+      for (int k = 0; k < 9; ++k)
+        if (mask >> k & 1) quality[j] = std::min(quality[j], samples[k]);
+      worst = std::min(worst, quality[j]);
+    }
+    // The seeds: within the band, at most max_seeds of them, the worst first (ties by index).
+    std::vector<std::pair<double, int32_t>> seeds;
+    for (size_t j = 0; j < problem.hexes.size(); ++j)
+      if (quality[j] <= 1.0 && quality[j] < worst + options.band)
+        seeds.push_back({quality[j], static_cast<int32_t>(j)});
+    if (static_cast<int64_t>(seeds.size()) > options.max_seeds) {
+      std::nth_element(seeds.begin(), seeds.begin() + options.max_seeds, seeds.end());
+      seeds.resize(static_cast<size_t>(options.max_seeds));
+    }
+    std::vector<int32_t> front;
+    for (const auto& [unused, j] : seeds) {
+      for (int32_t i : problem.hex_local_nodes[j])
+        if (i >= 0 && !chosen[i]) chosen[i] = 1, front.push_back(i);
+    }
+    for (int ring = 0; ring < options.rings; ++ring) {
+      std::vector<int32_t> next;
+      for (int32_t i : front)
+        for (int32_t k = problem.node_hex_offsets[i]; k < problem.node_hex_offsets[i + 1]; ++k)
+          for (int32_t j : problem.hex_local_nodes[problem.node_hex[k]])
+            if (j >= 0 && !chosen[j]) chosen[j] = 1, next.push_back(j);
+      front.swap(next);
+    }
+    std::vector<int32_t> var_of(n, -1);
+    for (int32_t i = 0; i < n; ++i)
+      if (chosen[i] && moves(i)) {
+        var_of[i] = static_cast<int32_t>(nodes_.size());
+        nodes_.push_back(problem.nodes[i]);
+        var_problem_.push_back(i);
+        if (problem.slides[i].kind != SlideKind::free) sliding_.push_back(var_of[i]);
+      }
+    return var_of;
+  }
+
+  /// The boundary faces of the sliding variables, each once (guard_faces_): an accepted step
+  /// keeps them on the reference surface (NodeProblem::surface), or the line search cuts it.
+  void sliding_guard_faces_collect() {
+    const NodeProblem& problem = problem_;
+    if (!problem.surface || problem.node_face_offsets.empty()) return;
+    for (int32_t v : sliding_)
+      for (int32_t k = problem.node_face_offsets[var_problem_[v]];
+           k < problem.node_face_offsets[var_problem_[v] + 1]; ++k)
+        guard_faces_.push_back(problem.node_face[k]);
+    std::sort(guard_faces_.begin(), guard_faces_.end());
+    guard_faces_.erase(std::unique(guard_faces_.begin(), guard_faces_.end()), guard_faces_.end());
+  }
+
+  /// The objective's hexes (those with a variable corner, problem order) with their edge-ratio
+  /// caps, corner variables and moving samples, and per variable its (hex, corner) pairs.
+  void objective_hexes_build(const std::vector<int32_t>& var_of) {
+    const NodeProblem& problem = problem_;
+    for (size_t j = 0; j < problem.hexes.size(); ++j) {
+      std::array<int32_t, 8> vars;
+      bool any = false;
+      for (int c = 0; c < 8; ++c) {
+        const int32_t i = problem.hex_local_nodes[j][c];
+        vars[c] = i >= 0 ? var_of[i] : -1;
+        any = any || vars[c] >= 0;
+      }
+      if (!any) continue;
+      std::array<bool, 8> corner_moves;
+      for (int c = 0; c < 8; ++c) corner_moves[c] = vars[c] >= 0;
+      hexes_.push_back(problem.hexes[j]);
+      edge_caps_.push_back(
+          hex_edge_ratio_cap(hex_points(mesh_, problem.hexes[j]), options_.max_edge_ratio));
+      hex_vars_.push_back(vars);
+      masks_.push_back(sample_mask(corner_moves));
+    }
+    // Variable -> (objective hex, corner), CSR, in hex order.
+    var_offsets_.assign(nodes_.size() + 1, 0);
+    for (const auto& vars : hex_vars_)
+      for (int32_t v : vars)
+        if (v >= 0) ++var_offsets_[v + 1];
+    for (size_t v = 0; v < nodes_.size(); ++v) var_offsets_[v + 1] += var_offsets_[v];
+    var_items_.resize(var_offsets_.back());
+    std::vector<int32_t> cursor(var_offsets_.begin(), var_offsets_.end() - 1);
+    for (size_t h = 0; h < hex_vars_.size(); ++h)
+      for (int c = 0; c < 8; ++c)
+        if (hex_vars_[h][c] >= 0) var_items_[cursor[hex_vars_[h][c]]++] = {int32_t(h), c};
+  }
+
+  /// The evaluation's buffers, the mean edge length of the objective's hexes (the step unit),
+  /// and the threads an evaluation uses.
+  void evaluation_buffers_size() {
+    samples_.resize(hexes_.size());
+    cap_samples_.assign(hexes_.size(), std::numeric_limits<double>::infinity());
+    hex_gradient_.resize(hexes_.size());
+    const int64_t chunks = parallel_chunk_count(static_cast<int64_t>(hexes_.size()), chunk_hexes);
+    chunk_min_.resize(chunks);
+    chunk_cap_min_.resize(chunks);
+    chunk_sum_.resize(chunks);
+    double edges = 0;
+    for (int32_t h : hexes_) {
+      const Corners p = hex_points(mesh_, h);
+      for (const auto& e : hex_edges) edges += (p[e[1]] - p[e[0]]).norm();
+    }
+    mean_edge_ = hexes_.empty() ? 0.0 : edges / (12.0 * static_cast<double>(hexes_.size()));
+    // Threads start per evaluation: below a few thousand hexes that costs more than it saves.
+    threads_ = hexes_.size() < 8 * chunk_hexes ? 1 : std::max(options_.threads, 1);
+  }
+
   HexMesh& mesh_;
   const NodeProblem& problem_;
   const JointAscentOptions& options_;
@@ -523,6 +552,54 @@ std::vector<uint8_t> nodes_moved_and_around(const HexMesh& mesh, const NodeProbl
         if (j >= 0) out[j] = 1;
   }
   return out;
+}
+
+/// The pairs (s, y) of f = -KS the L-BFGS history keeps, oldest first.
+using AscentHistory = std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>>;
+
+/// Step 3's quasi-Newton direction: the two-loop recursion on f = -KS (gradient -g) over
+/// `history`, d = -H (-g). `alpha`: scratch of the recursion.
+Eigen::VectorXd ascent_direction_two_loop(const AscentHistory& history,
+                                          const Eigen::VectorXd& gradient,
+                                          std::vector<double>& alpha) {
+  Eigen::VectorXd d = gradient;
+  alpha.assign(history.size(), 0.0);
+  for (int k = static_cast<int>(history.size()) - 1; k >= 0; --k) {
+    const auto& [s, y] = history[k];
+    alpha[k] = s.dot(d) / y.dot(s);
+    d -= alpha[k] * y;
+  }
+  if (!history.empty()) {
+    const auto& [s, y] = history.back();
+    d *= s.dot(y) / y.dot(y);
+  }
+  for (size_t k = 0; k < history.size(); ++k) {
+    const auto& [s, y] = history[k];
+    d += (alpha[k] - y.dot(d) / y.dot(s)) * s;
+  }
+  return d;
+}
+
+/// Step 3's line search from x (KS `value`, gradient `gradient`) along d: the step is capped so
+/// that no node moves more than `cap`, then halved (at most 30 times) until the Armijo
+/// condition holds and the guarded faces stay on the surface. True if a step was accepted:
+/// `trial` (before the slides' projection), its KS and its minimum are then that step's.
+bool ascent_step_search(JointProblem& joint, const Eigen::VectorXd& x, const Eigen::VectorXd& d,
+                        const Eigen::VectorXd& gradient, double value, double cap,
+                        Eigen::VectorXd& trial, double& trial_value, double& trial_min) {
+  // A sliding variable's entry of d keeps the component normal to its slide that L-BFGS's
+  // history gives it (the projection takes it out): projecting d onto the tangents first
+  // measured lower (docs/placement-and-smoothing.md, 'Smoothing's joint ascent').
+  double t = 1.0;
+  const double largest = joint.largest_move(d);
+  if (largest > cap) t = cap / largest;
+  const double slope = d.dot(gradient);
+  for (int halving = 0; halving < 30; ++halving, t *= 0.5) {
+    trial = x + t * d;
+    trial_value = joint.evaluate(trial, trial_min, nullptr);
+    if (trial_value >= value + 1e-4 * t * slope && joint.faces_on_surface()) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -584,50 +661,21 @@ JointAscentStats nodes_ascend_jointly(HexMesh& mesh, const NodeProblem& problem,
   joint.unguard_failing_faces();
   best_min = min;
   const double cap = 0.25 * joint.mean_edge();
-  std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> history;  // (s, y) of -KS
+  AscentHistory history;
   std::vector<double> alpha;
   int flat = 0, since_best = 0;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-    // Two-loop recursion on f = -KS (gradient -g): direction d = -H (-g).
-    Eigen::VectorXd d = gradient;
-    alpha.assign(history.size(), 0.0);
-    for (int k = static_cast<int>(history.size()) - 1; k >= 0; --k) {
-      const auto& [s, y] = history[k];
-      alpha[k] = s.dot(d) / y.dot(s);
-      d -= alpha[k] * y;
-    }
-    if (!history.empty()) {
-      const auto& [s, y] = history.back();
-      d *= s.dot(y) / y.dot(y);
-    }
-    for (size_t k = 0; k < history.size(); ++k) {
-      const auto& [s, y] = history[k];
-      d += (alpha[k] - y.dot(d) / y.dot(s)) * s;
-    }
+    Eigen::VectorXd d = ascent_direction_two_loop(history, gradient, alpha);
     if (history.empty() || !(d.dot(gradient) > 0)) {
       history.clear();
       const double largest = joint.largest_move(gradient);
       if (!(largest > 0)) break;
       d = gradient * (0.02 * joint.mean_edge() / largest);
     }
-    // A sliding variable's entry of d keeps the component normal to its slide that L-BFGS's
-    // history gives it (the projection takes it out): projecting d onto the tangents first
-    // measured lower (rockerarm sphere:0,0,0,5 smoothed, sheet: 0.493 against 0.529).
-    double t = 1.0;
-    const double largest = joint.largest_move(d);
-    if (largest > cap) t = cap / largest;
-    const double slope = d.dot(gradient);
     Eigen::VectorXd trial, trial_gradient;
     double trial_value = -std::numeric_limits<double>::infinity(), trial_min = 0;
-    bool accepted = false;
-    for (int halving = 0; halving < 30; ++halving, t *= 0.5) {
-      trial = x + t * d;
-      trial_value = joint.evaluate(trial, trial_min, nullptr);
-      if (trial_value >= value + 1e-4 * t * slope && joint.faces_on_surface()) {
-        accepted = true;
-        break;
-      }
-    }
+    const bool accepted =
+        ascent_step_search(joint, x, d, gradient, value, cap, trial, trial_value, trial_min);
     ++stats.iterations;
     if (!accepted) {
       if (history.empty()) break;

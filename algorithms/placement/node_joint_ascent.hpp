@@ -43,23 +43,23 @@ struct JointAscentOptions {
   /// variables too: their gradient is projected onto the tangent of their slide and every
   /// iterate puts them back onto it (slide_project), so they stay on the boundary surface by
   /// construction. false: they keep their place (node placement, whose sliding nodes are few and
-  /// whose sweeps slide them). Smoothing sets it: the worst children left by the sweeps sit next
-  /// to the boundary (results/worst_hexes.md: 73 of 109 with a boundary face), and their parent's
-  /// boundary corners must move with the interior nodes for the minimum to rise.
+  /// whose sweeps slide them). Smoothing sets it: the worst children left by the sweeps mostly
+  /// sit next to the boundary (docs/placement-and-smoothing.md, 'Smoothing's joint ascent'), and
+  /// their parent's boundary corners must move with the interior nodes for the minimum to rise.
   bool slide = false;
   /// A hex whose edge ratio nears its cap (within the last twentieth) adds a sample to the soft
   /// minimum that falls to 0 at the cap (node_joint_ascent.cpp), so the ascent is steered along
   /// the cap. false: the cap is only a wall, and a hex the sweeps left at its cap stops the
-  /// ascent at its first step (rockerarm sphere:0,0,0,5 smoothed: 0.4598 with the sliding nodes,
-  /// 0.4894 with both). Smoothing sets it; node placement and the template table's optimizer
-  /// (`hexrefine templates --optimize`) keep the wall, so that the committed table and the
-  /// placement figures (results/placement.md) stay reproducible.
+  /// ascent at its first step (docs/placement-and-smoothing.md, 'Smoothing'). Smoothing sets it;
+  /// node placement and the template table's optimizer (`hexrefine templates --optimize`) keep
+  /// the wall, so that the committed table and the placement figures (results/placement.md)
+  /// stay reproducible.
   bool cap_samples = false;
   /// >= 1: rounds of nodes_sweep_and_ascend (ascent, then sweeps from the nodes it moved), each
   /// with beta `round_beta_growth` (>= 1) times the last, while a round raises the minimum over
   /// the problem's hexes by more than `round_gain`. One ascent stalls where many hexes sit near
   /// the minimum: the sweeps move its worst hexes, and a sharper restart goes on from there
-  /// (rockerarm sphere:0,0,0,5 smoothed, sheet: 0.493 after one round, 0.528 after three).
+  /// (docs/placement-and-smoothing.md, 'Smoothing').
   int rounds = 1;
   double round_beta_growth = 2;  ///< >= 1: beta of a round over the last one's
   double round_gain = 1e-4;      ///< >= 0: a round raising the minimum by no more ends them

@@ -167,6 +167,9 @@ struct OptimizerShared {
 };
 
 /// One worker: the visits of one thread, with its own scratch buffers, over `shared`.
+/// Length: a class, not a function; its methods are short, the candidates and the guard of one
+/// node visit, kept in one class because they share the worker's scratch and its deferred
+/// surface guard.
 class Optimizer {
  public:
   /// `initialize`: this first worker fills `shared` (qualities, start positions, every sliding
@@ -610,6 +613,166 @@ void min_mean(const std::vector<double>& q, double& min, double& mean) {
   mean = sum / static_cast<double>(q.size());
 }
 
+/// What the sweeps of one nodes_optimize call share: the workers (the first one also serves the
+/// serial parts), the worst-first order and its levels, the active nodes, and the phase.
+struct NodeSweeps {
+  NodeSweeps(const NodeProblem& problem_in, const NodeOptimizerOptions& options_in,
+             std::vector<Optimizer>& workers_in)
+      : problem(problem_in),
+        options(options_in),
+        workers(workers_in),
+        threads(static_cast<int>(workers_in.size())),
+        n(static_cast<int32_t>(problem_in.nodes.size())),
+        active(n, 1),
+        next_active(n, 0),
+        level(n, -1) {}
+
+  const NodeProblem& problem;
+  const NodeOptimizerOptions& options;
+  std::vector<Optimizer>& workers;
+  int threads;
+  int32_t n;
+  /// Worst-first order by a counting sort on the quantised local minimum (linear, stable by id).
+  static constexpr int buckets = 4096;
+  std::vector<int32_t> bucket_offsets = std::vector<int32_t>(buckets + 1), order, keys;
+  /// Per node: 1 if it is visited in this sweep, in the next one.
+  std::vector<char> active, next_active;
+  /// Per node its level in the current sweep (-1: not reached yet); the sweep's nodes by level.
+  std::vector<int32_t> level, level_offsets, by_level;
+  /// Per worker: the largest move of this sweep over the local edge length.
+  std::vector<double> largest_relative_move;
+  /// The smooth phase runs its sweeps to the end (its soft objective).
+  bool soft = false;
+};
+
+/// The active nodes into s.order, worst first (ties by id); false when none is active.
+bool active_nodes_order_worst_first(NodeSweeps& s) {
+  const Optimizer& optimizer = s.workers.front();
+  constexpr int buckets = NodeSweeps::buckets;
+  std::fill(s.bucket_offsets.begin(), s.bucket_offsets.end(), 0);
+  s.keys.clear();
+  for (int32_t i = 0; i < s.n; ++i) {
+    if (!s.active[i]) continue;
+    const double q = std::clamp(optimizer.local_min(i), -1.0, 1.0);
+    s.keys.push_back(std::min(buckets - 1, static_cast<int>((q + 1.0) * 0.5 * buckets)));
+    ++s.bucket_offsets[s.keys.back() + 1];
+  }
+  if (s.keys.empty()) return false;
+  for (int b = 0; b < buckets; ++b) s.bucket_offsets[b + 1] += s.bucket_offsets[b];
+  s.order.resize(s.keys.size());
+  size_t k = 0;
+  for (int32_t i = 0; i < s.n; ++i)
+    if (s.active[i]) s.order[s.bucket_offsets[s.keys[k++]]++] = i;
+  return true;
+}
+
+/// Worker w visits every stride-th node of nodes[begin, end), from `begin`; the nodes around
+/// a node that moved become active for the next sweep.
+void nodes_visit(NodeSweeps& s, Optimizer& worker, int64_t w, const std::vector<int32_t>& nodes,
+                 int64_t begin, int64_t end, int64_t stride) {
+  const NodeProblem& problem = s.problem;
+  for (int64_t at = begin; at < end; at += stride) {
+    const int32_t i = nodes[at];
+    // A node visit() would leave (its worst hex at or above visit_below) costs no scale.
+    if (!(worker.local_min(i) < s.options.visit_below)) continue;
+    const double h = worker.scale(i);
+    const double moved = worker.visit(i);
+    if (!(moved > 0)) continue;
+    if (h > 0) s.largest_relative_move[w] = std::max(s.largest_relative_move[w], moved / h);
+    // Moves below a thousandth of the local edge length do not wake the neighbours.
+    if (h > 0 && moved < 1e-3 * h) continue;
+    for (int32_t m = problem.node_hex_offsets[i]; m < problem.node_hex_offsets[i + 1]; ++m)
+      for (int32_t j : problem.hex_local_nodes[problem.node_hex[m]])
+        if (j >= 0) std::atomic_ref<char>(s.next_active[j]).store(1, std::memory_order_relaxed);
+  }
+}
+
+/// Visits s.order level by level on s.threads workers. A node's level is one above the highest
+/// level of the nodes before it in the order that share a hex with it. A visit reads and writes
+/// only its own node, the nodes and hexes around it: visiting level by level, each node sees
+/// exactly what it would see in the serial sweep (the nodes before it that it depends on are in
+/// lower levels, those after it in higher ones), so the result is the serial sweep's, bit for
+/// bit, and the nodes of one level, which share no hex, can be visited in any order on any
+/// number of threads.
+void active_nodes_visit_by_levels(NodeSweeps& s) {
+  const NodeProblem& problem = s.problem;
+  Optimizer& optimizer = s.workers.front();
+  std::vector<int32_t>& level = s.level;
+  std::vector<int32_t>& level_offsets = s.level_offsets;
+  std::vector<int32_t>& by_level = s.by_level;
+  int32_t levels = 0;
+  for (int32_t i : s.order) {
+    int32_t l = 0;
+    for (int32_t m = problem.node_hex_offsets[i]; m < problem.node_hex_offsets[i + 1]; ++m)
+      for (int32_t j : problem.hex_local_nodes[problem.node_hex[m]])
+        if (j >= 0 && j != i && level[j] >= l) l = level[j] + 1;
+    level[i] = l;
+    levels = std::max(levels, l + 1);
+  }
+  level_offsets.assign(static_cast<size_t>(levels) + 1, 0);
+  for (int32_t i : s.order) ++level_offsets[level[i] + 1];
+  for (int32_t l = 0; l < levels; ++l) level_offsets[l + 1] += level_offsets[l];
+  by_level.resize(s.order.size());
+  for (int32_t i : s.order) by_level[level_offsets[level[i]]++] = i;
+  for (int32_t i : s.order) level[i] = -1;
+  for (int32_t l = levels; l > 0; --l) level_offsets[l] = level_offsets[l - 1];
+  level_offsets[0] = 0;
+  const int threads = s.threads;
+  for (int32_t l = 0; l < levels; ++l) {
+    // The nodes visit() would leave (their worst hex at or above visit_below, which
+    // within a level only their own visit changes) cost nothing: dropped first, so that
+    // the threads share the nodes that do cost.
+    int64_t end = level_offsets[l];
+    for (int64_t at = level_offsets[l]; at < level_offsets[l + 1]; ++at)
+      if (optimizer.local_min(by_level[at]) < s.options.visit_below) by_level[end++] = by_level[at];
+    const int64_t begin = level_offsets[l], size = end - begin;
+    // Small levels are not worth a thread.
+    if (size < 64) {
+      nodes_visit(s, optimizer, 0, by_level, begin, end, 1);
+      continue;
+    }
+    // Worker w visits every threads-th node from begin + w: the worst nodes, which cost
+    // most, are spread over the workers.
+    parallel_chunks(threads, threads, 1, [&](int64_t w, int64_t, int64_t) {
+      nodes_visit(s, s.workers[w], w, by_level, begin + w, end, threads);
+    });
+  }
+}
+
+/// Sweeps (at most max_sweeps) from the initially active nodes (options.initially_active
+/// outside the smooth phase, else every node), until no node is active, no node moved by more
+/// than 1e-7 of its local edge length, or (max-min phase) a sweep improved neither the minimum
+/// (by 1e-9) nor the mean (by 1e-6). Adds the sweeps to stats.sweeps.
+void nodes_sweep(NodeSweeps& s, int max_sweeps, NodeOptimizerStats& stats) {
+  const NodeOptimizerOptions& options = s.options;
+  Optimizer& optimizer = s.workers.front();
+  if (!s.soft && options.initially_active.size() == static_cast<size_t>(s.n))
+    std::copy(options.initially_active.begin(), options.initially_active.end(), s.active.begin());
+  else
+    std::fill(s.active.begin(), s.active.end(), 1);
+  double current_min, current_mean;
+  min_mean(optimizer.quality(), current_min, current_mean);
+  for (int sweep = 0; sweep < max_sweeps; ++sweep) {
+    if (!active_nodes_order_worst_first(s)) break;
+    std::fill(s.next_active.begin(), s.next_active.end(), 0);
+    s.largest_relative_move.assign(static_cast<size_t>(s.threads), 0.0);
+    if (s.threads == 1)
+      nodes_visit(s, optimizer, 0, s.order, 0, static_cast<int64_t>(s.order.size()), 1);
+    else
+      active_nodes_visit_by_levels(s);
+    s.active.swap(s.next_active);
+    ++stats.sweeps;
+    double sweep_min, sweep_mean;
+    min_mean(optimizer.quality(), sweep_min, sweep_mean);
+    const bool stalled = sweep_min - current_min <= 1e-9 && sweep_mean - current_mean <= 1e-6;
+    current_min = sweep_min;
+    current_mean = sweep_mean;
+    const double largest =
+        *std::max_element(s.largest_relative_move.begin(), s.largest_relative_move.end());
+    if (largest <= 1e-7 || (stalled && !s.soft)) break;
+  }
+}
+
 }  // namespace
 
 NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
@@ -624,133 +787,24 @@ NodeOptimizerStats nodes_optimize(HexMesh& mesh, const NodeProblem& problem,
   Optimizer& optimizer = workers.front();
   min_mean(optimizer.quality(), stats.min_before, stats.mean_before);
 
-  // Worst-first order by a counting sort on the quantised local minimum (linear, stable by id).
-  constexpr int buckets = 4096;
-  std::vector<int32_t> bucket_offsets(buckets + 1), order, keys;
-  std::vector<char> active(n, 1), next_active(n, 0);
-  // Per node its level in the current sweep (-1: not reached yet); the sweep's nodes by level.
-  std::vector<int32_t> level(n, -1), level_offsets, by_level;
-  bool soft = false;  // the smooth phase runs its sweeps to the end (its soft objective)
-  auto run_sweeps = [&](int max_sweeps) {
-    if (!soft && options.initially_active.size() == static_cast<size_t>(n))
-      std::copy(options.initially_active.begin(), options.initially_active.end(), active.begin());
-    else
-      std::fill(active.begin(), active.end(), 1);
-    double current_min, current_mean;
-    min_mean(optimizer.quality(), current_min, current_mean);
-    for (int sweep = 0; sweep < max_sweeps; ++sweep) {
-      std::fill(bucket_offsets.begin(), bucket_offsets.end(), 0);
-      keys.clear();
-      for (int32_t i = 0; i < n; ++i) {
-        if (!active[i]) continue;
-        const double q = std::clamp(optimizer.local_min(i), -1.0, 1.0);
-        keys.push_back(std::min(buckets - 1, static_cast<int>((q + 1.0) * 0.5 * buckets)));
-        ++bucket_offsets[keys.back() + 1];
-      }
-      if (keys.empty()) break;
-      for (int b = 0; b < buckets; ++b) bucket_offsets[b + 1] += bucket_offsets[b];
-      order.resize(keys.size());
-      size_t k = 0;
-      for (int32_t i = 0; i < n; ++i)
-        if (active[i]) order[bucket_offsets[keys[k++]]++] = i;
-
-      std::fill(next_active.begin(), next_active.end(), 0);
-      std::vector<double> largest_relative_move(static_cast<size_t>(threads), 0.0);
-      // Visits every stride-th node of nodes[begin, end), from `begin`.
-      auto visit_nodes = [&](Optimizer& worker, int64_t w, const std::vector<int32_t>& nodes,
-                             int64_t begin, int64_t end, int64_t stride) {
-        for (int64_t at = begin; at < end; at += stride) {
-          const int32_t i = nodes[at];
-          // A node visit() would leave (its worst hex at or above visit_below) costs no scale.
-          if (!(worker.local_min(i) < options.visit_below)) continue;
-          const double h = worker.scale(i);
-          const double moved = worker.visit(i);
-          if (!(moved > 0)) continue;
-          if (h > 0) largest_relative_move[w] = std::max(largest_relative_move[w], moved / h);
-          // Moves below a thousandth of the local edge length do not wake the neighbours.
-          if (h > 0 && moved < 1e-3 * h) continue;
-          for (int32_t m = problem.node_hex_offsets[i]; m < problem.node_hex_offsets[i + 1]; ++m)
-            for (int32_t j : problem.hex_local_nodes[problem.node_hex[m]])
-              if (j >= 0) std::atomic_ref<char>(next_active[j]).store(1, std::memory_order_relaxed);
-        }
-      };
-      if (threads == 1) {
-        visit_nodes(optimizer, 0, order, 0, static_cast<int64_t>(order.size()), 1);
-      } else {
-        // Levels of the worst-first order: a node's level is one above the highest level of
-        // the nodes before it in the order that share a hex with it. A visit reads and writes
-        // only its own node, the nodes and hexes around it: visiting level by level, each node
-        // sees exactly what it would see in the serial sweep above (the nodes before it that it
-        // depends on are in lower levels, those after it in higher ones), so the result is the
-        // serial sweep's, bit for bit, and the nodes of one level, which share no hex, can be
-        // visited in any order on any number of threads.
-        int32_t levels = 0;
-        for (int32_t i : order) {
-          int32_t l = 0;
-          for (int32_t m = problem.node_hex_offsets[i]; m < problem.node_hex_offsets[i + 1]; ++m)
-            for (int32_t j : problem.hex_local_nodes[problem.node_hex[m]])
-              if (j >= 0 && j != i && level[j] >= l) l = level[j] + 1;
-          level[i] = l;
-          levels = std::max(levels, l + 1);
-        }
-        level_offsets.assign(static_cast<size_t>(levels) + 1, 0);
-        for (int32_t i : order) ++level_offsets[level[i] + 1];
-        for (int32_t l = 0; l < levels; ++l) level_offsets[l + 1] += level_offsets[l];
-        by_level.resize(order.size());
-        for (int32_t i : order) by_level[level_offsets[level[i]]++] = i;
-        for (int32_t i : order) level[i] = -1;
-        for (int32_t l = levels; l > 0; --l) level_offsets[l] = level_offsets[l - 1];
-        level_offsets[0] = 0;
-        for (int32_t l = 0; l < levels; ++l) {
-          // The nodes visit() would leave (their worst hex at or above visit_below, which
-          // within a level only their own visit changes) cost nothing: dropped first, so that
-          // the threads share the nodes that do cost.
-          int64_t end = level_offsets[l];
-          for (int64_t at = level_offsets[l]; at < level_offsets[l + 1]; ++at)
-            if (optimizer.local_min(by_level[at]) < options.visit_below)
-              by_level[end++] = by_level[at];
-          const int64_t begin = level_offsets[l], size = end - begin;
-          // Small levels are not worth a thread.
-          if (size < 64) {
-            visit_nodes(optimizer, 0, by_level, begin, end, 1);
-            continue;
-          }
-          // Worker w visits every threads-th node from begin + w: the worst nodes, which cost
-          // most, are spread over the workers.
-          parallel_chunks(threads, threads, 1, [&](int64_t w, int64_t, int64_t) {
-            visit_nodes(workers[w], w, by_level, begin + w, end, threads);
-          });
-        }
-      }
-      active.swap(next_active);
-      ++stats.sweeps;
-      double sweep_min, sweep_mean;
-      min_mean(optimizer.quality(), sweep_min, sweep_mean);
-      const bool stalled = sweep_min - current_min <= 1e-9 && sweep_mean - current_mean <= 1e-6;
-      current_min = sweep_min;
-      current_mean = sweep_mean;
-      const double largest =
-          *std::max_element(largest_relative_move.begin(), largest_relative_move.end());
-      if (largest <= 1e-7 || (stalled && !soft)) break;
-    }
-  };
+  NodeSweeps sweeps(problem, options, workers);
   std::vector<Vec3> saved;
   if (options.smooth_sweeps > 0) {
     for (int32_t node : problem.nodes) saved.push_back(mesh.points[node]);
-    soft = true;
+    sweeps.soft = true;
     optimizer.set_phase(true, options.smooth_beta);
-    run_sweeps(options.smooth_sweeps);
-    soft = false;
+    nodes_sweep(sweeps, options.smooth_sweeps, stats);
+    sweeps.soft = false;
   }
   optimizer.set_phase(false, 60.0);
-  run_sweeps(options.max_sweeps);
+  nodes_sweep(sweeps, options.max_sweeps, stats);
   if (!saved.empty()) {
     double min_now, mean_now;
     min_mean(optimizer.quality(), min_now, mean_now);
     if (min_now < stats.min_before) {
       // The smooth phase led somewhere worse: start again from where it started.
       for (int32_t i = 0; i < n; ++i) optimizer.restore(i, saved[i]);
-      run_sweeps(options.max_sweeps);
+      nodes_sweep(sweeps, options.max_sweeps, stats);
     }
   }
   min_mean(optimizer.quality(), stats.min_after, stats.mean_after);

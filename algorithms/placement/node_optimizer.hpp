@@ -68,12 +68,11 @@ struct NodeOptimizerOptions {
   /// No move may give a hex an edge ratio (hex_edge_ratio) above hex_edge_ratio_cap(its start,
   /// max_edge_ratio) (<= 0: no cap). The scaled Jacobian is blind to edge length: maximising its
   /// minimum alone pulls two new nodes of a transition together until their edge is a
-  /// thousandth of the others (the shared rocker arm's sphere:0,0,0,5, selective: a largest
-  /// edge ratio of 4,330 where the trilinear positions give 14.9), hexes fine by their angles
-  /// and useless to an analysis. 20 (PlacementOptions and SmoothOptions too): above what the
-  /// templates give the children of the shared meshes' parents (8 on the sphere's 2:1 boundary
-  /// parents); over the real-mesh study's cases (results/edge_ratio_cap.md) the smoothed
-  /// minimum over the parents' is 0.453 at 10, 0.531 at 20, 0.546 at 30 (geometric means).
+  /// thousandth of the others, hexes fine by their angles and useless to an analysis. 20
+  /// (PlacementOptions and SmoothOptions too): above what the templates give the children of
+  /// the shared meshes' parents, and past it a looser cap gains little smoothed quality
+  /// (docs/placement-and-smoothing.md, 'The edge-ratio cap' and 'The edge-ratio cap's default';
+  /// results/edge_ratio_cap.md).
   double max_edge_ratio = 20;
   /// Never turn a hex with a positive scaled Jacobian non-positive (smoothing). false: an
   /// inverted hex may be traded for a less inverted one while untangling (placement), as long

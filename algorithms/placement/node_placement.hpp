@@ -30,10 +30,9 @@ enum class PlacementMethod : uint8_t {
   /// from positions that have not yet used up the edge-ratio room
   /// (PlacementOptions::max_edge_ratio). Over the real-mesh study's cases smoothing ends higher
   /// from here than from `optimized` (results/smooth_start.md). Not from the reference
-  /// positions, although issue 29 asked for it: smoothed from them, 14 cases of the shared
-  /// meshes (both refiners) ended lower on 7 (rockerarm `sphere:0,0,0,5` selective 0.459 ->
-  /// 0.367, bunny and cube-minus-sphere 2 % random 0.21 -> 0.09), higher on 4, equal on 3
-  /// (docs/placement-and-smoothing.md): the reference positions spend the room smoothing needs.
+  /// positions, although issue 29 asked for it: smoothed from them, the shared meshes' cases
+  /// ended lower more often than higher (docs/placement-and-smoothing.md, 'Why `untangle` keeps
+  /// the thesis' positions'): the reference positions spend the room smoothing needs.
   untangle,
   /// Every new node at the parent's trilinear map of the template's reference position
   /// (template_reference.hpp: the positions that maximise the worst child on the unit cube),
@@ -62,8 +61,8 @@ struct PlacementOptions {
   /// is worst, and the band keeps it to those children and the hexes around them. In rounds: the
   /// first from the start positions; then, while the worst child rises, the band around the new
   /// worst, as long as each round fits what is left of a budget of max(active_floor,
-  /// active_share x the pass's new hexes) children (a 40^3 brick with 3 % random targets: one
-  /// round, 227 of 319,132 children; the same brick jittered: 552 in four; results/placement.md).
+  /// active_share x the pass's new hexes) children, so the optimisation costs a share of the
+  /// refinement (docs/placement-and-smoothing.md, 'Where placement starts'; results/placement.md).
   double active_band = 0.25;
   double active_share = 0.005;
   double active_floor = 0;

@@ -76,8 +76,8 @@ struct SmoothOptions {
   /// visit or joint-ascent step is then kept only if the boundary faces at the moved nodes still
   /// pass the checker's test (reference_surface_holds_face; NodeProblem::surface says which
   /// faces and when): a node slid over a bend of the input can leave a face whose
-  /// centroid sags off the surface (phm_rabbit random:0.02,1, selective), which
-  /// `check --reference` rejects. The same surface as check's, so the two agree.
+  /// centroid sags off the surface (docs/placement-and-smoothing.md, 'Smoothing and the check
+  /// agree'), which `check --reference` rejects. The same surface as check's, so the two agree.
   const ReferenceSurface* reference_surface = nullptr;
   /// Mesh node ids (in [0, node_count), any order) that stay where they are although in the
   /// region: refine --smooth pins the corners of the boundary faces the checker rejected in a
@@ -90,10 +90,9 @@ struct SmoothOptions {
   /// max_sweeps 0 (which only measures). A round stops earlier where its minimum stalls
   /// (JointAscentOptions::stall_iterations), so the budget costs only where the ascent still
   /// climbs, which it does slowly but steadily around transitions that must thicken as a layer:
-  /// over the real-mesh study's 274 smoothed cases with refined parents
-  /// (results/smoothing_budget_all/smoothing_budget.md) 1000 lifts the children to 0.5 x the
-  /// parents on 235 against 218 with 100 (phm_lever_arm surface:0, selective: 0.309 -> 0.591 of the
-  /// parents), at a median 194 x the refinement against 123 x.
+  /// over the real-mesh study 1000 lifts more cases' children to 0.5 x the parents than 100, at
+  /// about one and a half times the smoothing time (docs/placement-and-smoothing.md, 'Its
+  /// budget'; results/smoothing_budget_all/smoothing_budget.md).
   int joint_iterations = 1000;
   /// >= 1: rounds of joint ascent and sweeps, while a round raises the minimum
   /// (JointAscentOptions::rounds; results/smoothing_budget.md compares one round and three on

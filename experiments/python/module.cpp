@@ -16,7 +16,7 @@
 #include <string>
 
 #include "algorithms/pipeline/pipeline.hpp"
-#include "experiments/runner.hpp"
+#include "experiments/runner/runner.hpp"
 #include "mesh/conformity.hpp"
 #include "mesh/error.hpp"
 #include "mesh/generators.hpp"

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/cli.hpp"
+#include "experiments/cli/cli.hpp"
 
 namespace hexrefine {
 namespace {

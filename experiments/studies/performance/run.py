@@ -234,6 +234,14 @@ def command_section():
     w("refine run starts without its output file (replacing a 1 GB file frees its page cache")
     w("inside the rename: the file system's cost, paid by `rm` as much).")
     w("")
+    command_table(runs, spreads)
+    command_previous_paragraph(runs)
+    command_huge_pages_table(runs)
+    command_sizes_and_changes(c)
+
+
+def command_table(runs, spreads):
+    """The table of the median runs: each command's wall time, runs, stages, peak and target."""
     def verdict(r, limit_mb, limit):
         # Time and memory judged apart: one can be met while the other is not.
         time = "met" if r["wall_s"] <= 3 else "not met"
@@ -266,6 +274,10 @@ def command_section():
         w(f"| convert .e to binary .vtk | 1 | {r['wall_s']:.2f} | {spreads[r['name']]} | | | | | "
           f"{r['peak_rss_MB']} | (was 10.7 s) |")
     w("")
+
+
+def command_previous_paragraph(runs):
+    """The previous run (command_previous.json) against this one, if it exists."""
     previous_path = os.path.join(here, "command_previous.json")
     if os.path.exists(previous_path):
         p = load("command_previous.json")
@@ -294,6 +306,10 @@ def command_section():
           + (" (that run was one run per command, not a median)." if p.get("repeats", 1) == 1
              else "."))
         w("")
+
+
+def command_huge_pages_table(runs):
+    """The same commands on 4 KiB pages (command_no_huge_pages.json), if it exists."""
     small_pages_path = os.path.join(here, "command_no_huge_pages.json")
     if os.path.exists(small_pages_path):
         q = load("command_no_huge_pages.json")
@@ -301,7 +317,7 @@ def command_section():
         w(f"Huge pages: the same commands with `HEXREFINE_HUGE_PAGES=0` (4 KiB pages; "
           f"`command_no_huge_pages.json`, {q['date']}, right after the run above). The command "
           "re-executes itself with glibc's `glibc.malloc.hugetlb=1` where the kernel gives "
-          "transparent huge pages on request (`experiments/process_huge_pages.hpp`); each "
+          "transparent huge pages on request (`experiments/bench/process_huge_pages.hpp`); each "
           "report records whether it ran with them.")
         w("")
         w("| command | threads | wall s, huge pages | wall s, 4 KiB pages | refine stage, huge | refine stage, 4 KiB |")
@@ -317,6 +333,10 @@ def command_section():
               f"{other['wall_s']:.2f} | {'' if huge is None else f'{huge:.2f}'} | "
               f"{'' if small is None else f'{small:.2f}'} |")
         w("")
+
+
+def command_sizes_and_changes(c):
+    """The output sizes, the file-system floor and what the issue-14 changes did."""
     size_e, size_vtu = c["output_bytes"]["e"], c["output_bytes"]["vtu"]
     raw = 11390625 * (8 * 4 + 4 + 1) + 11543176 * 24  # Int32 connectivity, offsets, types; Float64 points
     attributes = 11390625 * 4 * 4  # block_id, template_tag, refinement_level, parent_hex (Int32)
@@ -433,7 +453,7 @@ def checker_section():
                      f"one (CPU {one['cpu_s']['median']:.3f} s, "
                      f"{one['hexes_per_cpu_s'] / 1e6:.1f} M hexes per CPU second)")
     w("The checker without a reference (what `hexrefine check` runs), medians: " +
-      "; ".join(rates) + ". `mesh_check` rows: bench_checker (experiments/benchmarks), the mesh")
+      "; ".join(rates) + ". `mesh_check` rows: bench_checker (experiments/bench), the mesh")
     w("in memory, CPU time the process's (both threads); `hexrefine check` rows: the command's")
     w("check stage from its report (read stage left out). The refine rows: the whole command's")
     w("wall time by the script's clock around the process, against the refine stage of the same")

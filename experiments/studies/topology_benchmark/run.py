@@ -60,7 +60,7 @@ def main():
     lines = [
         "# Topology benchmark",
         "",
-        "`experiments/benchmarks/bench_topology.cpp`, Release build, regular n x n x n bricks "
+        "`experiments/bench/bench_topology.cpp`, Release build, regular n x n x n bricks "
         "(`generate_brick`), median of 5 repetitions. boundary_surface_build works on the 6 n^2 "
         "boundary faces only; its hexes/s is still counted over the whole mesh.",
         "Regenerate this page and `topology.png` with "

@@ -1,0 +1,7 @@
+#include "experiments/cli/cli.hpp"
+#include "experiments/bench/process_huge_pages.hpp"
+
+int main(int argc, char** argv) {
+  hexrefine::process_prefer_huge_pages(argv);
+  return hexrefine::cli_main(argc, argv);
+}

@@ -1,7 +1,0 @@
-#include "experiments/cli.hpp"
-#include "experiments/process_huge_pages.hpp"
-
-int main(int argc, char** argv) {
-  hexrefine::process_prefer_huge_pages(argv);
-  return hexrefine::cli_main(argc, argv);
-}

@@ -32,7 +32,7 @@ import time
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(ROOT / "experiments"))
+sys.path.insert(0, str(ROOT / "experiments" / "studies"))
 
 PROBLEMS = ["lshape", "rockerarm", "fichera"]
 METHODS = ["uniform", "selective", "sheet", "selective-trilinear", "selective-smooth",

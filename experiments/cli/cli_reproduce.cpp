@@ -1,18 +1,19 @@
 /// \file
 /// The two commands that regenerate results/ from the code as it is:
 /// - `hexrefine reproduce [--quick] [--out DIR] [--resume] [--quiet] [--no-plots]`: the thesis
-///   suite (cases.hpp) to results/thesis.jsonl, tables and plots by experiments/plots.py. The full
-///   suite goes to results/ (regenerating the committed results is what it is for); the quick
-///   one (sweeps up to n = 30) to the build folder's results/quick/, so that the README's main
-///   command leaves a clone's tracked files untouched (`git status` stays clean); the committed
-///   results/quick/ is regenerated only on purpose, with `--quick --out results/quick`.
+///   suite (cases.hpp) to results/thesis.jsonl, tables and plots by
+///   experiments/studies/thesis/report.py. The full suite goes to results/ (regenerating the
+///   committed results is what it is for); the quick one (sweeps up to n = 30) to the build
+///   folder's results/quick/, so that the README's main command leaves a clone's tracked files
+///   untouched (`git status` stays clean); the committed results/quick/ is regenerated only on
+///   purpose, with `--quick --out results/quick`.
 /// - `hexrefine study [--meshes DIR]... [--no-shared] [--max-hexes-input N] [--out DIR] [--quick]
 ///   [--resume] [--quiet] [--no-plots]`: the real-mesh study (real_mesh_study_cases) over every
 ///   mesh of ../shared/meshes and of each --meshes folder to results/real_meshes.jsonl, report
-///   and histograms by experiments/real_meshes_report.py; --quick: only the meshes of at most 200
-///   hexes, to the build folder's results/quick/ (as reproduce's). The case file names the shared
-///   meshes relative to itself (a clean clone beside ../shared runs it) and the --meshes ones by
-///   absolute path (a user's folder).
+///   and histograms by experiments/studies/real_meshes/report.py; --quick: only the meshes of at
+///   most 200 hexes, to the build folder's results/quick/ (as reproduce's). The case file names the
+///   shared meshes relative to itself (a clean clone beside ../shared runs it) and the --meshes
+///   ones by absolute path (a user's folder).
 /// Each writes its case file beside its records, runs it through the runner and then the
 /// script; a failing script names the rerun command.
 
@@ -24,8 +25,8 @@
 #include <iostream>
 #include <optional>
 
-#include "experiments/runner/cases.hpp"
 #include "experiments/cli/cli.hpp"
+#include "experiments/runner/cases.hpp"
 #include "experiments/runner/runner.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
@@ -114,7 +115,8 @@ int reproduce_run(const CliArgs& a) {
   const fs::path results = results_dir(a, "reproduce", quick);
   const std::string meshes = meshes_dir().lexically_relative(results).string();
   return suite_run(
-      a, thesis_suite_cases(quick, meshes, "thesis.jsonl"), results / "cases.json", "plots.py",
+      a, thesis_suite_cases(quick, meshes, "thesis.jsonl"), results / "cases.json",
+      "studies/thesis/report.py",
       "--thesis " + shell_quote((fs::path(run_shared_dir()) / "thesis" / "tables.json").string()) +
           " --out " + shell_quote(results.string()));
 }
@@ -186,7 +188,7 @@ int study_run(const CliArgs& a) {
     if (!a.flag("--quiet"))
       for (const std::string& s : skipped) std::cerr << "hexrefine study: left out " << s << "\n";
   }
-  return suite_run(a, cases, case_file, "real_meshes_report.py",
+  return suite_run(a, cases, case_file, "studies/real_meshes/report.py",
                    "--out " + shell_quote(results.string()));
 }
 
@@ -205,7 +207,7 @@ const CliCommand cli_reproduce_command = {
          "quick results)"},
         {"--resume", "", "keep the records already written"},
         {"--quiet", "", "no progress lines"},
-        {"--no-plots", "", "records only: skip experiments/plots.py"},
+        {"--no-plots", "", "records only: skip experiments/studies/thesis/report.py"},
     },
     "",
     reproduce_run,
@@ -228,7 +230,7 @@ const CliCommand cli_study_command = {
          "only the meshes of at most 200 hexes, to the build folder's results/quick/"},
         {"--resume", "", "keep the records already written"},
         {"--quiet", "", "no progress lines"},
-        {"--no-plots", "", "records only: skip experiments/real_meshes_report.py"},
+        {"--no-plots", "", "records only: skip experiments/studies/real_meshes/report.py"},
     },
     "Exit status 2 when a --meshes folder cannot be read. Each unreadable mesh file is left out "
     "and named.",

@@ -43,4 +43,4 @@ for m in selective sheet; do
 done
 printf '\n}\n' >> "$out/peak_memory.json.tmp"
 mv "$out/peak_memory.json.tmp" "$out/peak_memory.json"
-python3 "$out/report.py"
+python3 "$repo/experiments/studies/performance/run.py"

@@ -5,17 +5,18 @@
 # memory (/usr/bin/time -v) of each command, output sizes, and the floor of this machine's file
 # system: the time `dd` takes to write as many bytes into the page cache, and how fast fresh
 # memory is first touched (1 GiB twice in one process). Every command runs RUNS times (default
-# 3) back to back; report.py shows the median run and the spread. Each refine run starts
-# without its output file: replacing an existing 1 GB file frees its page cache inside the
-# rename, which is the file system's cost, not the command's. Writes
-# results/performance/command.json; report.py turns it into a section of results/performance.md.
+# 3) back to back; the report (experiments/studies/performance/run.py) shows the median run and
+# the spread. Each refine run starts without its output file: replacing an existing 1 GB file
+# frees its page cache inside the rename, which is the file system's cost, not the command's.
+# Writes results/performance/command.json; the report turns it into a section of
+# results/performance.md.
 # Needs a Release build (cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && make -C build hexrefine)
 # and about 3 GB of memory and 4 GB of disk in $TMPDIR; about 8 minutes on an idle machine.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 bin=$repo/build/experiments/hexrefine
 # OUT: another output file, e.g. for a run with HEXREFINE_HUGE_PAGES=0 (4 KiB pages), which
-# report.py compares with command.json.
+# the report (experiments/studies/performance/run.py) compares with command.json.
 out=${OUT:-$repo/results/performance/command.json}
 repeats=${RUNS:-3}
 tmp=$(mktemp -d)

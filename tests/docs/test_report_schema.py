@@ -234,7 +234,8 @@ def test_docs_report_md_holds_the_schemas_key_tables_and_names_every_key():
     assert len(keys) > 100
     missing = sorted(k for k in keys if f"`{k}`" not in text)
     assert missing == []
-    result = subprocess.run(["/usr/bin/python3", str(SCHEMA_DIR / "key_tables.py")],
+    result = subprocess.run(["/usr/bin/python3",
+                             str(SOURCE / "experiments" / "tools" / "key_tables.py")],
                             capture_output=True, text=True, check=True)
-    assert result.stdout.strip() in text  # else: python3 docs/schema/key_tables.py --update
+    assert result.stdout.strip() in text  # else: python3 experiments/tools/key_tables.py --update
     assert "## Changelog" in text and "schema_version 1" in text and "schema_version 2" in text

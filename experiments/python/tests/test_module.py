@@ -353,7 +353,7 @@ def test_refine_keywords_are_the_options_table(brick10, tmp_path):
 
 def test_ablation_example_runs_and_writes_its_records(tmp_path):
     script = pathlib.Path(os.environ.get("HEXREFINE_SOURCE_DIR", ".")) / "experiments" / \
-        "examples" / "ablation.py"
+        "studies" / "ablation" / "run.py"
     out = tmp_path / "ablation.json"
     subprocess.run([sys.executable, str(script), "--quick", "--seeds", "2", "--placement",
                     "trilinear", "--json", str(out)], check=True, capture_output=True)

@@ -156,10 +156,10 @@ TEST(CliRun, RunsBothMethodsOnTheSameTargetsAndChecksTheOutputs) {
 namespace hexrefine {
 namespace {
 
-/// Runs experiments/plots.py (matplotlib is a CI dependency, .ci/setup.sh).
+/// Runs experiments/studies/thesis/report.py (matplotlib is a CI dependency, .ci/setup.sh).
 CliRun plots_py(const std::string& args) {
   return shell_run(std::string("/usr/bin/python3 ") + HEXREFINE_SOURCE_DIR +
-                   "/experiments/plots.py " + args);
+                   "/experiments/studies/thesis/report.py " + args);
 }
 
 TEST(PlotsPy, PutsOursBesideTheThesisWithRatios) {

@@ -1,5 +1,5 @@
 // `hexrefine study` end to end with a folder of meshes (--meshes), and its report script
-// (experiments/real_meshes_report.py) on synthetic records.
+// (experiments/studies/real_meshes/report.py) on synthetic records.
 
 #include <gtest/gtest.h>
 
@@ -151,9 +151,10 @@ TEST(RealMeshesReport, CountsTheTargetsOfIssue28PerArm) {
   text += failed.dump() + "\n";
   test_file_put(dir / "r.jsonl", text);
 
-  const CliRun r = shell_run(std::string("/usr/bin/python3 ") + HEXREFINE_SOURCE_DIR +
-                             "/experiments/real_meshes_report.py " + (dir / "r.jsonl").string() +
-                             " --out " + (dir / "out").string() + " --quiet");
+  const CliRun r =
+      shell_run(std::string("/usr/bin/python3 ") + HEXREFINE_SOURCE_DIR +
+                "/experiments/studies/real_meshes/report.py " + (dir / "r.jsonl").string() +
+                " --out " + (dir / "out").string() + " --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string md = test_file_text(dir / "out" / "real_meshes.md");
   for (const char* row : {
@@ -181,7 +182,7 @@ TEST(RealMeshesReport, CountsTheTargetsOfIssue28PerArm) {
 
   test_file_put(dir / "none.jsonl", "{\"tags\": {}}\n");
   const CliRun none = shell_run(std::string("/usr/bin/python3 ") + HEXREFINE_SOURCE_DIR +
-                                "/experiments/real_meshes_report.py " +
+                                "/experiments/studies/real_meshes/report.py " +
                                 (dir / "none.jsonl").string() + " --out " + (dir / "out").string());
   EXPECT_EQ(none.exit_code, 2);
   EXPECT_NE(none.output.find("no records of the real-mesh study"), std::string::npos)

@@ -21,7 +21,7 @@
 ///   "slower?" / "faster?". Benchmarks with an error are listed as errors, not compared.
 /// - `bench --history FILE.jsonl` appends one line per run: commit (git, of the current folder),
 ///   date, machine, and per benchmark the median, minimum and maximum real and CPU seconds and
-///   the number of repetitions; results/bench/plot_history.py draws it.
+///   the number of repetitions; experiments/studies/bench_history/run.py draws it.
 /// - Exit codes: bench-compare returns 0 whatever the ratios (a comparison of times is
 ///   information, not a verdict) and 2 for unreadable or malformed input; bench returns 1 if an
 ///   executable fails.
@@ -52,9 +52,9 @@
 #include <vector>
 
 #include "experiments/bench/bench_statistics.hpp"
+#include "experiments/bench/process_huge_pages.hpp"
 #include "experiments/cli/cli.hpp"
 #include "experiments/cli/cli_bench.hpp"
-#include "experiments/bench/process_huge_pages.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
 

@@ -56,7 +56,7 @@ json thesis_suite_cases(bool quick, const std::string& meshes_dir, const std::st
   const std::string corner_ball = "sphere:1,0,1,0.5";
   json cases = json::array();
 
-  // The small ones keep their refined meshes for experiments/render_mesh.py.
+  // The small ones keep their refined meshes for experiments/studies/render_mesh.py.
   json g1 = make_case("G-1", brick(10, 10, 10), l_shape, {{"table", "G-1"}});
   g1["save_mesh"] = true;
   cases.push_back(g1);

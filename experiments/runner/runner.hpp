@@ -45,7 +45,8 @@ struct RunCase {
   /// ("passes", "smooth" and the "options" object), checked: case_execute sets its
   /// PipelineOptions from them; `options` and `smooth` are what they give (the record's key).
   nlohmann::json settings = nlohmann::json::object();
-  bool save_mesh = false;  ///< write each refined mesh as .vtu (for experiments/render_mesh.py)
+  bool save_mesh =
+      false;  ///< write each refined mesh as .vtu (for experiments/studies/render_mesh.py)
   /// Set by run_plan_execute when save_mesh: the folder "<output stem>.meshes" beside the output.
   std::string save_mesh_dir;
   nlohmann::json tags = nlohmann::json::object();

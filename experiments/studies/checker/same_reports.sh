@@ -5,12 +5,12 @@
 # mesh of ../shared/meshes) and compares their JSON reports field for field (the field
 # self_contact_faces, which BASE does not have, left out; floating-point values compared as
 # printed with 17 digits, i.e. bit for bit). Writes results/performance/checker_same_reports.json.
-# Needs a Release build of the working tree (build/mesh/libmesh.a, build/experiments/hexrefine);
+# Needs a Release build of the working tree (build/mesh/libhexrefine_mesh.a, build/experiments/hexrefine);
 # compiles BASE's mesh/ sources (git archive) into a temporary folder. About five minutes.
 set -euo pipefail
-repo=$(cd "$(dirname "$0")/.." && pwd)
+repo=$(cd "$(dirname "$0")/../../.." && pwd)
 base=${1:-bb967b0}
-shared=${HEXREFINE_SHARED_DIR:-$repo/../../shared}
+shared=${HEXREFINE_SHARED_DIR:-$repo/../shared}
 [ -d "$shared/meshes" ] || shared=/work/shared
 out=$repo/results/performance/checker_same_reports.json
 tmp=$(mktemp -d)
@@ -40,7 +40,7 @@ git -C "$repo" archive "$base" mesh | tar -x -C "$tmp/base"
 g++ -std=c++20 -O3 -DNDEBUG -I"$tmp/base" -isystem /usr/include/eigen3 "$tmp/dump.cpp" \
   "$tmp/base/libmesh.a" $libs -o "$tmp/dump_base"
 g++ -std=c++20 -O3 -DNDEBUG -I"$repo" -isystem /usr/include/eigen3 "$tmp/dump.cpp" \
-  "$repo/build/mesh/libmesh.a" $libs -o "$tmp/dump_new"
+  "$repo/build/mesh/libhexrefine_mesh.a" $libs -o "$tmp/dump_new"
 bin=$repo/build/experiments/hexrefine
 cases=()
 for n in 50 75; do

@@ -13,7 +13,7 @@
 # Needs a Release build (cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && make -C build hexrefine)
 # and about 3 GB of memory and 4 GB of disk in $TMPDIR; about 8 minutes on an idle machine.
 set -euo pipefail
-repo=$(cd "$(dirname "$0")/../.." && pwd)
+repo=$(cd "$(dirname "$0")/../../.." && pwd)
 bin=$repo/build/experiments/hexrefine
 # OUT: another output file, e.g. for a run with HEXREFINE_HUGE_PAGES=0 (4 KiB pages), which
 # the report (experiments/studies/performance/run.py) compares with command.json.

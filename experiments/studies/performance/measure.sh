@@ -5,7 +5,7 @@
 #   make -C build -j2 hexrefine bench_refiners bench_topology
 # Run it on an idle machine: about 10 minutes, up to 2 GB of memory.
 set -euo pipefail
-repo=$(cd "$(dirname "$0")/../.." && pwd)
+repo=$(cd "$(dirname "$0")/../../.." && pwd)
 bin=$repo/build/experiments
 out=$repo/results/performance
 reps=${REPS:-5}

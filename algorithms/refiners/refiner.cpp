@@ -191,7 +191,7 @@ const RefineMethod& refine_method(std::string_view name) {
 }
 
 RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targets& targets,
-                    const RefineOptions& options) {
+                    const RefineOptions& options, const TemplateLibrary& templates) {
   const auto t0 = Clock::now();
   const std::string name(method.name);
   refine_input_validate(mesh, targets, options, name);
@@ -246,7 +246,7 @@ RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targe
     RefinementPlan plan;
     PlanApplyResult applied;
     for (int attempt = 0;; ++attempt) {
-      plan = method.plan(*current, topology, pass_targets, options, stats);
+      plan = method.plan(*current, topology, pass_targets, options, stats, templates);
       stats.phase_seconds["plan"] += seconds_since(t);
 
       t = Clock::now();

@@ -18,6 +18,7 @@
 
 #include "algorithms/placement/node_placement.hpp"
 #include "algorithms/templates/template_engine.hpp"
+#include "algorithms/templates/template_reference.hpp"
 #include "mesh/hex_mesh.hpp"
 #include "mesh/topology.hpp"
 
@@ -144,10 +145,12 @@ struct RefineResult {
 /// A refinement method: decides one pass over `mesh`. `targets` are ascending, unique and in
 /// range; `topology` was built from `mesh` (TopologyParts::all). The plan's uses mark the
 /// targets (TemplateUse::target). Throws OperationError naming the hexes where the method cannot
-/// handle the configuration.
+/// handle the configuration. The plan's templates are `templates`' (its standard templates and
+/// directional configurations, which it must outlive).
 using RefinePlanFn = RefinementPlan (*)(const HexMesh& mesh, const HexTopology& topology,
                                         const std::vector<int32_t>& targets,
-                                        const RefineOptions& options, RefineStats& stats);
+                                        const RefineOptions& options, RefineStats& stats,
+                                        const TemplateLibrary& templates);
 
 struct RefineMethod {
   std::string_view name;
@@ -175,8 +178,10 @@ void refine_input_validate(const HexMesh& mesh, const Targets& targets,
 /// with, for methods that use a buffer and passes > 1, options.buffer's additions (PassBuffer).
 /// Throws InputError for invalid targets or options, or (unless options.allow_inverted) an input
 /// with hexes of scaled Jacobian <= 0, naming them; OperationError where the method refuses or no
-/// valid placement was found, naming the hexes.
+/// valid placement was found, naming the hexes. `templates`: the library the passes take their
+/// templates from (the committed table's; the template optimiser passes candidates).
 RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targets& targets,
-                    const RefineOptions& options);
+                    const RefineOptions& options,
+                    const TemplateLibrary& templates = template_library_committed());
 
 }  // namespace hexrefine

@@ -75,14 +75,17 @@ std::vector<NewEdge> template_new_edges(const HexTemplate& t) {
   return out;
 }
 
+/// By tag: which edges a step makes depends on the template's nodes and children alone, the
+/// same in every library.
 const std::vector<NewEdge>& new_edges_of(const HexTemplate* t) {
-  static const HexTemplate* keys[4] = {&template_1_5(), &template_1_4(), &template_1_3_adjust1(),
-                                       &template_1_3_adjust2()};
+  static const TemplateTag keys[4] = {TemplateTag::t1_5, TemplateTag::t1_4,
+                                      TemplateTag::t1_3_adjust1, TemplateTag::t1_3_adjust2};
   static const std::vector<NewEdge> lists[5] = {
-      template_new_edges(*keys[0]), template_new_edges(*keys[1]), template_new_edges(*keys[2]),
-      template_new_edges(*keys[3]), template_new_edges(template_1_3())};
+      template_new_edges(template_1_5()), template_new_edges(template_1_4()),
+      template_new_edges(template_1_3_adjust1()), template_new_edges(template_1_3_adjust2()),
+      template_new_edges(template_1_3())};
   for (int i = 0; i < 4; ++i)
-    if (keys[i] == t) return lists[i];
+    if (keys[i] == t->tag) return lists[i];
   return lists[4];
 }
 
@@ -261,7 +264,7 @@ bool SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
       if (d.split[le] && hex_edge_axis[le] == k) mask |= static_cast<uint16_t>(1u << le);
     }
     if (k < 0 || !mask) continue;
-    d.choice = template_for_mask(mask);
+    d.choice = templates_.choice(mask);
     if (c.collapsed || !c.exact)
       throw OperationError("selective_refine: hex " + std::to_string(c.hex) +
                            ": a sub-hex next to an adjustment needs further refinement (not "

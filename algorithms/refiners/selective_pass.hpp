@@ -59,16 +59,19 @@ inline SegmentKey segment_key(const NodeKey& a, const NodeKey& b) {
 
 class SelectivePass {
  public:
-  /// `forced_splits`: input edges split from the outset (found by earlier attempts).
+  /// `forced_splits`: input edges split from the outset (found by earlier attempts); every
+  /// template from `templates`.
   SelectivePass(const HexMesh& mesh, const HexTopology& topology,
                 const std::vector<int32_t>& targets, const RefineOptions& options,
-                RefineStats& stats, const std::vector<int32_t>& forced_splits)
+                RefineStats& stats, const std::vector<int32_t>& forced_splits,
+                const TemplateLibrary& templates)
       : mesh_(mesh),
         topo_(topology),
         targets_(targets),
         options_(options),
         stats_(stats),
         forced_splits_(forced_splits),
+        templates_(templates),
         cells_refiner_(mesh, topology) {}
 
   /// Decides the pass (Parrish, Table 5-1) and returns its plan.
@@ -115,6 +118,7 @@ class SelectivePass {
   const RefineOptions& options_;
   RefineStats& stats_;
   const std::vector<int32_t>& forced_splits_;
+  const TemplateLibrary& templates_;
   CellRefiner cells_refiner_;
   std::vector<uint8_t> split_;  // per input edge
   std::vector<uint8_t> role_;   // per input hex

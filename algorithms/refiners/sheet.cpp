@@ -344,7 +344,7 @@ SheetMarking sheet_mark(const HexMesh& mesh, const HexTopology& topology, const 
 
 RefinementPlan sheet_plan(const HexMesh& mesh, const HexTopology& topology,
                           const std::vector<int32_t>& targets, const RefineOptions& options,
-                          RefineStats& stats) {
+                          RefineStats& stats, const TemplateLibrary& templates) {
   const SheetPass pass = sheet_pass_prepare(mesh, topology, targets, false, stats);
   const auto t_composites = Clock::now();
   // Configuration: 8 mark bits, then per axis 2 bits of (rank + 1).
@@ -379,7 +379,7 @@ RefinementPlan sheet_plan(const HexMesh& mesh, const HexTopology& topology,
     const uint32_t key = marks | (rank[0] + 1) << 8 | (rank[1] + 1) << 10 | (rank[2] + 1) << 12;
     if (!composites[key]) {
       composites[key] =
-          sheet_composite_build(marks, rank, h, options.placement.configuration_table,
+          sheet_composite_build(marks, rank, h, templates, options.placement.configuration_table,
                                 options.placement.method != PlacementMethod::trilinear);
       if (!composites[key]->positive)
         throw OperationError("sheet refinement: the refinement of input hex " + std::to_string(h) +

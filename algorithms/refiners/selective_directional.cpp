@@ -98,7 +98,23 @@ void SelectivePass::rank() {
     cells_[di].push_back(cells_refiner_.cell_whole(directional_[di]));
   stats_.directional_hexes += nd;
   if (nd == 0) return;
-  // Groups (face-connected directional hexes).
+  const std::vector<int32_t> group = directional_groups();
+  const bool by_hex = options_.directional_order == DirectionalOrder::by_hex;
+  if (!options_.ranking) {
+    rounds_without_ranking(by_hex);
+    return;
+  }
+  std::vector<int32_t> rank_of;
+  const std::vector<Rank> members = ranks_build(group, rank_of);
+  stats_.ranks += static_cast<int64_t>(members.size());
+  if (by_hex)
+    rounds_by_hex(rank_of);
+  else
+    rounds_by_rank(members);
+}
+
+std::vector<int32_t> SelectivePass::directional_groups() {
+  const int32_t nd = static_cast<int32_t>(directional_.size());
   std::vector<int32_t> group(nd, -1);
   int64_t groups = 0;
   std::vector<int32_t> stack;
@@ -119,21 +135,25 @@ void SelectivePass::rank() {
     ++groups;
   }
   stats_.directional_groups += groups;
+  return group;
+}
 
-  const bool by_hex = options_.directional_order == DirectionalOrder::by_hex;
-  if (!options_.ranking) {
-    // Ablation: local x, y, z in turn, hex after hex, or each local direction for every hex.
-    if (by_hex) {
-      for (int32_t di = 0; di < nd; ++di)
-        for (int8_t d = 0; d < 3; ++d) rounds_.push_back({{di, d}});
-    } else {
-      for (int8_t d = 0; d < 3; ++d) {
-        rounds_.emplace_back();
-        for (int32_t di = 0; di < nd; ++di) rounds_.back().push_back({di, d});
-      }
+void SelectivePass::rounds_without_ranking(bool by_hex) {
+  const int32_t nd = static_cast<int32_t>(directional_.size());
+  if (by_hex) {
+    for (int32_t di = 0; di < nd; ++di)
+      for (int8_t d = 0; d < 3; ++d) rounds_.push_back({{di, d}});
+  } else {
+    for (int8_t d = 0; d < 3; ++d) {
+      rounds_.emplace_back();
+      for (int32_t di = 0; di < nd; ++di) rounds_.back().push_back({di, d});
     }
-    return;
   }
+}
+
+std::vector<SelectivePass::Rank> SelectivePass::ranks_build(const std::vector<int32_t>& group,
+                                                            std::vector<int32_t>& rank_of) {
+  const int32_t nd = static_cast<int32_t>(directional_.size());
   // Seeds: (hex, direction) by decreasing split count, then group, hex, direction.
   std::vector<std::array<int32_t, 4>> seeds;  // -count, group, di, d
   for (int32_t di = 0; di < nd; ++di) {
@@ -145,8 +165,8 @@ void SelectivePass::rank() {
     }
   }
   std::sort(seeds.begin(), seeds.end());
-  std::vector<int32_t> rank_of(3 * static_cast<size_t>(nd), -1);
-  std::vector<std::vector<std::pair<int32_t, int8_t>>> members;
+  rank_of.assign(3 * static_cast<size_t>(nd), -1);
+  std::vector<Rank> members;
   std::vector<std::pair<int32_t, int8_t>> queue;
   for (const auto& sd : seeds) {
     const int32_t di0 = sd[2];
@@ -177,20 +197,23 @@ void SelectivePass::rank() {
       }
     }
   }
-  stats_.ranks += static_cast<int64_t>(members.size());
-  if (by_hex) {
-    // The thesis' loop: each hex's directions by increasing rank, one step each, hex after hex.
-    for (int32_t di = 0; di < nd; ++di) {
-      std::array<int8_t, 3> order = {0, 1, 2};
-      std::sort(order.begin(), order.end(),
-                [&](int8_t a, int8_t b) { return rank_of[3 * di + a] < rank_of[3 * di + b]; });
-      for (int8_t d : order) rounds_.push_back({{di, d}});
-    }
-    return;
+  return members;
+}
+
+void SelectivePass::rounds_by_hex(const std::vector<int32_t>& rank_of) {
+  const int32_t nd = static_cast<int32_t>(directional_.size());
+  for (int32_t di = 0; di < nd; ++di) {
+    std::array<int8_t, 3> order = {0, 1, 2};
+    std::sort(order.begin(), order.end(),
+              [&](int8_t a, int8_t b) { return rank_of[3 * di + a] < rank_of[3 * di + b]; });
+    for (int8_t d : order) rounds_.push_back({{di, d}});
   }
+}
+
+void SelectivePass::rounds_by_rank(const std::vector<Rank>& members) {
   // A hex met twice by one rank (a self-intersecting sheet) refines those directions in turn.
-  std::vector<int8_t> seen_in_rank(nd, 0);
-  for (auto& m : members) {
+  std::vector<int8_t> seen_in_rank(directional_.size(), 0);
+  for (const auto& m : members) {
     std::vector<std::pair<int32_t, int8_t>> first, later;
     for (const auto& x : m) (seen_in_rank[x.first]++ ? later : first).push_back(x);
     for (const auto& x : m) seen_in_rank[x.first] = 0;

@@ -65,7 +65,7 @@ void input_validate(const HexMesh& mesh, std::string_view method) {
                      " (allow_inverted, --allow-inverted, refines them anyway)");
 }
 
-/// The last resort of node placement (issue 28: no refusal of a valid input). Placement moves
+/// The last resort of node placement (a valid input is never refused). Placement moves
 /// only new nodes; where even the retargets leave children inverted (a transition template in a
 /// parent whose own corners hold a child folded), the nodes around those children move too,
 /// the parents' input nodes included, as smoothing moves them (algorithms/placement/smoothing.hpp:
@@ -87,8 +87,8 @@ std::vector<int32_t> placement_fallback_untangle(HexMesh& refined,
   // edge-ratio cap holds a child inverted, run again without it over a wider region (an inverted
   // child has no quality to protect; a stretched edge shows in the report's max_edge_ratio). That
   // second run has no joint ascent: without the cap the ascent raises the scaled Jacobian by
-  // collapsing edges (ecr_cap.mesh ball, untangle: largest edge ratio 3.3e8 with it, 183 without),
-  // and every later stage caps a hex at its ratio from here.
+  // collapsing edges (results/methods.md, "The placement fallback's uncapped run"), and every
+  // later stage caps a hex at its ratio from here.
   SmoothOptions smoothing;  // the smoothing's default budget: the region is a few hundred hexes
   smoothing.region_hexes = inverted;
   smoothing.layers = 2;

@@ -35,13 +35,15 @@ enum class PassBuffer {
   /// The thesis' rule, read from Table H-2's counts: every pass (the first included) refines the
   /// descendants of the user's targets plus one layer of hexes of the current mesh face-adjacent
   /// to them; the layer's children are not carried into the next pass, so every transition of
-  /// the next pass sits in an unrefined-by-transition cube. H-2: 370,304 hexes, minimum 0.3077.
+  /// the next pass sits in an unrefined-by-transition cube. The one rule of the three that gives
+  /// H-2's count and minimum exactly (results/methods.md, choice 1).
   layer,
   /// The descendants of the user's targets only: each pass's transitions are refined again by
-  /// the next pass's templates (H-2: 332,448 hexes, minimum 0.003831).
+  /// the next pass's templates, which degrades them pass after pass (results/methods.md,
+  /// choice 1).
   none,
-  /// Every child of the previous pass's transitions joins the next pass's targets, cumulatively
-  /// (H-2: 472,384 hexes, minimum 0.3077).
+  /// Every child of the previous pass's transitions joins the next pass's targets, cumulatively:
+  /// H-2's minimum with more hexes than the thesis counts (results/methods.md, choice 1).
   transitions,
 };
 NLOHMANN_JSON_SERIALIZE_ENUM(PassBuffer, {{PassBuffer::layer, "layer"},
@@ -55,9 +57,9 @@ PassBuffer pass_buffer_from_name(std::string_view name);
 /// pairs it must refine (each step followed by the propagation scheme).
 enum class DirectionalOrder {
   /// Rank after rank: all pairs of a rank (or, without the ranking system, all hexes' local
-  /// x, then y, then z) in one step. On every case tried (G-1, G-3 at n = 20, 40, 75, random
-  /// and blob targets on rockerarm, ellipsoid, cube-minus-sphere and sphere meshes) the output
-  /// is the same as by_hex's: the propagation scheme closes the split edges to the same set.
+  /// x, then y, then z) in one step. On every case tried the output is the same as by_hex's
+  /// (results/methods.md, choice 2): the propagation scheme closes the split edges to the same
+  /// set.
   by_rank,
   /// Hex after hex, each hex's directions in rank order (without ranking: local x, y, z), "until
   /// the hexahedron is completely refined and the algorithm moves onto the next hexahedron"

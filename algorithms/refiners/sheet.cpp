@@ -99,7 +99,8 @@ void marking_seed(const HexMesh& mesh, const std::vector<int32_t>& targets, Shee
 // decides all candidates on the marks of the previous wave, then adds them together. (Adding
 // one hex at a time would depend on the visiting order: a hex can get all its nodes marked by
 // its neighbours' growth and be fully refined without ever being added, which changes
-// added_targets; the thesis' L-shaped case adds exactly the 810 non-target hexes.)
+// added_targets; the waves add exactly the thesis' count on its L-shaped case, which
+// tests/algorithms/refiners/test_sheet.cpp asserts.)
 void marking_grow(const HexMesh& mesh, const HexTopology& topology,
                   const std::vector<int32_t>& targets, SheetMarking& m) {
   std::vector<uint8_t> queued(mesh.hexes.size(), 0);

@@ -177,12 +177,14 @@ HexTemplate template_standard_exact(TemplateTag tag);
 /// reference positions the exact ones).
 HexTemplate template_1_13_build(double interior_height);
 /// Height of the four interior nodes of 1-13. The minimum scaled Jacobian is 4/13 = 0.3077 (the
-/// thesis' L-shaped value) for every height in (0, 0.27], fixed by the corner children; above
-/// that it drops (0.5 is degenerate). 1/6 lies inside the plateau and on the sixths grid.
+/// thesis' L-shaped value) on a plateau of low heights, fixed by the corner children; above it
+/// it drops (0.5 is degenerate; the scan: results/methods.md, "Template constants"). 1/6 lies
+/// inside the plateau and on the sixths grid.
 inline constexpr double template_1_13_interior_height = 1.0 / 6.0;
 /// Depth q of adjustment nodes: (x, q, q) for an adjustment at edge (y1, z1). A multiple of 1/6
 /// so that sub-hexes of directional refinement keep exact reference positions. Chosen, not given
-/// by the thesis (its Figure E-21 is missing): 5/6 gives the L-shaped case 0.3077, 2/3 0.2582.
+/// by the thesis (its Figure E-21 is missing): 5/6 gives the L-shaped case a higher minimum than
+/// 2/3 (results/methods.md, "Template constants").
 inline constexpr double template_adjustment_depth = 5.0 / 6.0;
 
 /// Which templates a split-edge pattern may call for.

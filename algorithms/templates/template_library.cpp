@@ -327,6 +327,13 @@ HexTemplate template_standard_exact(TemplateTag tag) {
   }
 }
 
+HexTemplate template_standard_build(TemplateTag tag, const TemplateReferenceTable& table) {
+  HexTemplate t = template_standard_exact(tag);
+  template_reference_from_table(t, table);
+  template_compile(t);
+  return t;
+}
+
 const HexTemplate& template_1_27() {
   return template_library_committed().of(TemplateTag::t1_27);
 }
@@ -390,8 +397,8 @@ uint16_t template_split_edges(const HexTemplate& tmpl) {
   return mask;
 }
 
-TemplateMaskTable template_mask_table(std::span<const HexTemplate* const> templates) {
-  TemplateMaskTable out{};
+void template_mask_table_fill(std::span<const HexTemplate* const> templates,
+                              TemplateMaskTable& out) {
   for (const HexTemplate* t : templates) {
     const uint16_t canonical = template_split_edges(*t);
     for (int s = 0; s < 48; ++s) {
@@ -399,7 +406,6 @@ TemplateMaskTable template_mask_table(std::span<const HexTemplate* const> templa
       if (!out[m].tmpl) out[m] = {t, static_cast<int8_t>(s)};
     }
   }
-  return out;
 }
 
 std::vector<TemplateTag> template_set_tags(TemplateSet set) {

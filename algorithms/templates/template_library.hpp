@@ -207,12 +207,14 @@ struct TemplateChoice {
 /// One choice per split-edge mask (4096).
 using TemplateMaskTable = std::array<TemplateChoice, 4096>;
 
-/// The mask table of a set's templates (`templates`, in order; they must outlive it): for each
-/// template and each of the 48 symmetries, the mask the symmetry maps its canonical mask onto;
-/// the first template and symmetry to reach a mask win.
-TemplateMaskTable template_mask_table(std::span<const HexTemplate* const> templates);
+/// Fills `table` (every choice empty on entry) as the mask table of a set's templates
+/// (`templates`, in order; they must outlive it): for each template and each of the 48
+/// symmetries, the mask the symmetry maps its canonical mask onto; the first template and
+/// symmetry to reach a mask win. In place: a table is 64 KiB, built where it stays.
+void template_mask_table_fill(std::span<const HexTemplate* const> templates,
+                              TemplateMaskTable& table);
 
-/// The templates of `set` in the order template_mask_table takes them.
+/// The templates of `set` in the order template_mask_table_fill takes them.
 std::vector<TemplateTag> template_set_tags(TemplateSet set);
 
 /// The committed library's choice for `mask` (TemplateLibrary::choice).

@@ -36,12 +36,7 @@ struct TableTemplate {
 using TablePosition = std::array<double, 3>;
 /// A directional configuration's row (ascending (hash0, hash1)): its movable nodes, in the
 /// canonical order, are table_configuration_positions[first .. first + count).
-struct TableConfiguration {
-  uint64_t hash0, hash1;
-  int32_t nodes, first, count;
-  double composed_min, reference_min;
-  int64_t seen;
-};
+using TableConfiguration = TemplateLibrary::ConfigurationRow;
 
 #include "algorithms/templates/template_reference_table.inc"
 
@@ -82,11 +77,47 @@ int standard_index(TemplateTag tag) {
   return -1;
 }
 
-/// The mask table of `set` over the templates of `library`.
-TemplateMaskTable library_mask_table(const TemplateLibrary& library, TemplateSet set) {
+/// The mask table of `set` over the templates of `library`, in place.
+void library_mask_table_fill(TemplateLibrary& library, TemplateSet set) {
   std::vector<const HexTemplate*> templates;
   for (TemplateTag tag : template_set_tags(set)) templates.push_back(&library.of(tag));
-  return template_mask_table(templates);
+  template_mask_table_fill(templates, library.masks[static_cast<int>(set)]);
+}
+
+/// The standard templates of `library` at `table`'s reference positions and their mask tables.
+void library_templates_build(TemplateLibrary& library, const TemplateReferenceTable& table) {
+  for (size_t i = 0; i < template_standard_tags.size(); ++i)
+    library.standard[i] = template_standard_build(template_standard_tags[i], table);
+  for (TemplateSet set : {TemplateSet::element_by_element, TemplateSet::sheet_directional})
+    library_mask_table_fill(library, set);
+}
+
+/// The committed table's rules and standard templates' rows, without its configurations (what
+/// the committed library builds its templates from; it reads the configurations in place).
+TemplateReferenceTable committed_templates() {
+  TemplateReferenceTable table;
+  table.rules = template_reference_rules();
+  table.adjustment_case_min = table_adjustment_case_min;
+  table.max_edge_ratio = table_max_edge_ratio;
+  table.configuration_edge_ratio = table_configuration_edge_ratio;
+  table.corpus = table_corpus;
+  table.corpus_hexes = table_corpus_hexes;
+  table.corpus_configurations = table_corpus_configurations;
+  table.corpus_worst_min = table_corpus_worst_min;
+  for (const TableTemplate& row : table_templates) {
+    TemplateReferenceEntry e;
+    e.tag = row.tag;
+    e.trilinear_min = row.trilinear_min;
+    e.reference_min = row.reference_min;
+    e.own_rule_min = row.own_rule_min;
+    e.own_rule = table.rules;
+    e.own_rule.along = row.own_along;
+    e.own_rule.across = row.own_across;
+    e.interior.assign(table_template_positions.begin() + row.first,
+                      table_template_positions.begin() + row.first + row.count);
+    table.templates.push_back(std::move(e));
+  }
+  return table;
 }
 
 }  // namespace
@@ -291,69 +322,60 @@ const HexTemplate& TemplateLibrary::of(TemplateTag tag) const {
 }
 
 std::unique_ptr<const TemplateLibrary> template_library_build(const TemplateReferenceTable& table) {
-  auto library = std::make_unique<TemplateLibrary>();
-  for (size_t i = 0; i < template_standard_tags.size(); ++i) {
-    HexTemplate& t = library->standard[i];
-    t = template_standard_exact(template_standard_tags[i]);
-    template_reference_from_table(t, table);
-    template_compile(t);
+  // Default-initialised (not value-initialised: the mask tables' empty choices are written
+  // once, by their member initialisers).
+  std::unique_ptr<TemplateLibrary> library(new TemplateLibrary);
+  library_templates_build(*library, table);
+  for (const TemplateReferenceConfiguration& c : table.configurations) {
+    const auto first = static_cast<int32_t>(library->configuration_position_storage.size());
+    library->configuration_row_storage.push_back({c.hash[0], c.hash[1], c.nodes, first,
+                                                  static_cast<int32_t>(c.movable.size()),
+                                                  c.composed_min, c.reference_min, c.seen});
+    library->configuration_position_storage.insert(library->configuration_position_storage.end(),
+                                                   c.movable.begin(), c.movable.end());
   }
-  for (TemplateSet set : {TemplateSet::element_by_element, TemplateSet::sheet_directional})
-    library->masks[static_cast<int>(set)] = library_mask_table(*library, set);
-  library->configurations = table.configurations;
+  library->configuration_rows = library->configuration_row_storage;
+  library->configuration_positions = library->configuration_position_storage;
   return library;
 }
 
 const TemplateLibrary& template_library_committed() {
-  static const std::unique_ptr<const TemplateLibrary> library =
-      template_library_build(template_reference_committed());
+  static const std::unique_ptr<const TemplateLibrary> library = [] {
+    std::unique_ptr<TemplateLibrary> committed(new TemplateLibrary);
+    library_templates_build(*committed, committed_templates());
+    committed->configuration_rows = table_configurations;
+    committed->configuration_positions = table_configuration_positions;
+    return committed;
+  }();
   return *library;
 }
 
 bool template_reference_from_configurations(HexTemplate& t, const TemplateLibrary& templates) {
-  const std::vector<TemplateReferenceConfiguration>& table = templates.configurations;
+  const std::span<const TableConfiguration> table = templates.configuration_rows;
   if (table.empty()) return false;
   const TemplateConfiguration c = template_configuration(t);
-  const auto at = std::lower_bound(table.begin(), table.end(), c.hash,
-                                   [](const TemplateReferenceConfiguration& row,
-                                      const std::array<uint64_t, 2>& h) { return row.hash < h; });
-  if (at == table.end() || at->hash != c.hash || at->nodes != static_cast<int32_t>(t.nodes.size()))
+  const auto at =
+      std::lower_bound(table.begin(), table.end(), c.hash,
+                       [](const TableConfiguration& row, const std::array<uint64_t, 2>& h) {
+                         return std::array<uint64_t, 2>{row.hash0, row.hash1} < h;
+                       });
+  if (at == table.end() || std::array<uint64_t, 2>{at->hash0, at->hash1} != c.hash ||
+      at->nodes != static_cast<int32_t>(t.nodes.size()))
     return false;
   std::vector<int32_t> movable;
   for (int32_t i : c.order)
     if (template_node_movable(t, static_cast<size_t>(i))) movable.push_back(i);
-  if (movable.size() != at->movable.size()) return false;
+  if (movable.size() != static_cast<size_t>(at->count)) return false;
   if (t.reference.empty())
     for (const TemplateNode& n : t.nodes) t.reference.push_back(n.ref);
   const CubeSymmetry& s = cube_symmetries()[c.symmetry];
   for (size_t k = 0; k < movable.size(); ++k)
-    t.reference[movable[k]] = symmetry_inverse(s, at->movable[k]);
+    t.reference[movable[k]] = symmetry_inverse(s, templates.configuration_positions[at->first + k]);
   return true;
 }
 
 TemplateReferenceTable template_reference_committed() {
-  TemplateReferenceTable table;
-  table.rules = template_reference_rules();
-  table.adjustment_case_min = table_adjustment_case_min;
-  table.max_edge_ratio = table_max_edge_ratio;
-  table.configuration_edge_ratio = table_configuration_edge_ratio;
-  table.corpus = table_corpus;
-  table.corpus_hexes = table_corpus_hexes;
-  table.corpus_configurations = table_corpus_configurations;
-  table.corpus_worst_min = table_corpus_worst_min;
-  for (const TableTemplate& row : table_templates) {
-    TemplateReferenceEntry e;
-    e.tag = row.tag;
-    e.trilinear_min = row.trilinear_min;
-    e.reference_min = row.reference_min;
-    e.own_rule_min = row.own_rule_min;
-    e.own_rule = table.rules;
-    e.own_rule.along = row.own_along;
-    e.own_rule.across = row.own_across;
-    e.interior.assign(table_template_positions.begin() + row.first,
-                      table_template_positions.begin() + row.first + row.count);
-    table.templates.push_back(std::move(e));
-  }
+  TemplateReferenceTable table = committed_templates();
   for (const TableConfiguration& row : table_configurations) {
     TemplateReferenceConfiguration c;
     c.hash = {row.hash0, row.hash1};

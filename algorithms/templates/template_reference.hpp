@@ -161,13 +161,27 @@ TemplateConfiguration template_configuration(const HexTemplate& tmpl);
 /// refinement (refine()'s `templates`), never a table swapped under the library. Neither
 /// copyable nor movable: the mask tables point into `standard`.
 struct TemplateLibrary {
+  /// One directional configuration as the table file lists it: its movable nodes' positions
+  /// (canonical order) are configuration_positions[first .. first + count).
+  struct ConfigurationRow {
+    uint64_t hash0, hash1;
+    int32_t nodes, first, count;
+    double composed_min, reference_min;
+    int64_t seen;
+  };
   /// 1-27, 1-13, 1-5, 1-4, 1-3, 1-3 with one and with two adjustments, 1-9 (template_standard_tags
   /// order).
   std::array<HexTemplate, 8> standard;
-  /// Per TemplateSet: the template and symmetry of each split-edge mask (template_mask_table).
+  /// Per TemplateSet: the template and symmetry of each split-edge mask
+  /// (template_mask_table_fill).
   std::array<TemplateMaskTable, 2> masks;
-  /// The table's directional configurations, ascending hash.
-  std::vector<TemplateReferenceConfiguration> configurations;
+  /// The table's directional configurations, ascending (hash0, hash1), and their positions: the
+  /// committed table's compiled-in arrays themselves (nothing to build before the first lookup),
+  /// or another table's, held in the storage below.
+  std::span<const ConfigurationRow> configuration_rows;
+  std::span<const std::array<double, 3>> configuration_positions;
+  std::vector<ConfigurationRow> configuration_row_storage;
+  std::vector<std::array<double, 3>> configuration_position_storage;
 
   TemplateLibrary() = default;
   TemplateLibrary(const TemplateLibrary&) = delete;
@@ -181,10 +195,13 @@ struct TemplateLibrary {
   }
 };
 
-/// The library of `table`: every standard template (template_standard_exact) with its reference
-/// positions from the table (template_reference_from_table) and compiled, the mask tables of
+/// The library of `table`: every standard template (template_standard_build), the mask tables of
 /// both sets, the table's configurations. Throws OperationError as template_reference_from_table.
 std::unique_ptr<const TemplateLibrary> template_library_build(const TemplateReferenceTable& table);
+
+/// The standard template tagged `tag` (template_standard_exact) with its reference positions
+/// from `table` (template_reference_from_table), compiled for the 48 symmetries.
+HexTemplate template_standard_build(TemplateTag tag, const TemplateReferenceTable& table);
 
 /// The library of the committed table, built once (thread-safe): what every refinement uses
 /// unless it is given another, and what template_1_27() ... template_for_mask() return from.

@@ -18,6 +18,7 @@
 
 #include "algorithms/placement/node_placement.hpp"
 #include "algorithms/templates/template_engine.hpp"
+#include "algorithms/templates/template_reference.hpp"
 #include "mesh/hex_mesh.hpp"
 #include "mesh/topology.hpp"
 
@@ -34,13 +35,15 @@ enum class PassBuffer {
   /// The thesis' rule, read from Table H-2's counts: every pass (the first included) refines the
   /// descendants of the user's targets plus one layer of hexes of the current mesh face-adjacent
   /// to them; the layer's children are not carried into the next pass, so every transition of
-  /// the next pass sits in an unrefined-by-transition cube. H-2: 370,304 hexes, minimum 0.3077.
+  /// the next pass sits in an unrefined-by-transition cube. The one rule of the three that gives
+  /// H-2's count and minimum exactly (results/methods.md, choice 1).
   layer,
   /// The descendants of the user's targets only: each pass's transitions are refined again by
-  /// the next pass's templates (H-2: 332,448 hexes, minimum 0.003831).
+  /// the next pass's templates, which degrades them pass after pass (results/methods.md,
+  /// choice 1).
   none,
-  /// Every child of the previous pass's transitions joins the next pass's targets, cumulatively
-  /// (H-2: 472,384 hexes, minimum 0.3077).
+  /// Every child of the previous pass's transitions joins the next pass's targets, cumulatively:
+  /// H-2's minimum with more hexes than the thesis counts (results/methods.md, choice 1).
   transitions,
 };
 NLOHMANN_JSON_SERIALIZE_ENUM(PassBuffer, {{PassBuffer::layer, "layer"},
@@ -54,9 +57,9 @@ PassBuffer pass_buffer_from_name(std::string_view name);
 /// pairs it must refine (each step followed by the propagation scheme).
 enum class DirectionalOrder {
   /// Rank after rank: all pairs of a rank (or, without the ranking system, all hexes' local
-  /// x, then y, then z) in one step. On every case tried (G-1, G-3 at n = 20, 40, 75, random
-  /// and blob targets on rockerarm, ellipsoid, cube-minus-sphere and sphere meshes) the output
-  /// is the same as by_hex's: the propagation scheme closes the split edges to the same set.
+  /// x, then y, then z) in one step. On every case tried the output is the same as by_hex's
+  /// (results/methods.md, choice 2): the propagation scheme closes the split edges to the same
+  /// set.
   by_rank,
   /// Hex after hex, each hex's directions in rank order (without ranking: local x, y, z), "until
   /// the hexahedron is completely refined and the algorithm moves onto the next hexahedron"
@@ -144,10 +147,12 @@ struct RefineResult {
 /// A refinement method: decides one pass over `mesh`. `targets` are ascending, unique and in
 /// range; `topology` was built from `mesh` (TopologyParts::all). The plan's uses mark the
 /// targets (TemplateUse::target). Throws OperationError naming the hexes where the method cannot
-/// handle the configuration.
+/// handle the configuration. The plan's templates are `templates`' (its standard templates and
+/// directional configurations, which it must outlive).
 using RefinePlanFn = RefinementPlan (*)(const HexMesh& mesh, const HexTopology& topology,
                                         const std::vector<int32_t>& targets,
-                                        const RefineOptions& options, RefineStats& stats);
+                                        const RefineOptions& options, RefineStats& stats,
+                                        const TemplateLibrary& templates);
 
 struct RefineMethod {
   std::string_view name;
@@ -175,8 +180,10 @@ void refine_input_validate(const HexMesh& mesh, const Targets& targets,
 /// with, for methods that use a buffer and passes > 1, options.buffer's additions (PassBuffer).
 /// Throws InputError for invalid targets or options, or (unless options.allow_inverted) an input
 /// with hexes of scaled Jacobian <= 0, naming them; OperationError where the method refuses or no
-/// valid placement was found, naming the hexes.
+/// valid placement was found, naming the hexes. `templates`: the library the passes take their
+/// templates from (the committed table's; the template optimiser passes candidates).
 RefineResult refine(const RefineMethod& method, const HexMesh& mesh, const Targets& targets,
-                    const RefineOptions& options);
+                    const RefineOptions& options,
+                    const TemplateLibrary& templates = template_library_committed());
 
 }  // namespace hexrefine

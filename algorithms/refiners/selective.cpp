@@ -52,10 +52,11 @@ double seconds_since(Clock::time_point t0) {
 
 // Local edges an element-by-element template or a directional step would adjust at, for a hex
 // with split mask `mask` (bits = local edges). Returns the count written to `out`.
-int adjustment_edges(uint16_t mask, bool directional, std::array<int, 12>& out) {
+int adjustment_edges(const TemplateLibrary& templates, uint16_t mask, bool directional,
+                     std::array<int, 12>& out) {
   int n = 0;
   auto collect = [&](uint16_t m) {
-    const TemplateChoice c = template_for_mask(m);
+    const TemplateChoice c = templates.choice(m);
     if (!c.tmpl) return;
     for (const TemplateNode& tn : c.tmpl->nodes)
       if (tn.adjustment_edge >= 0 && tn.adjustment_index == 0)
@@ -128,7 +129,7 @@ void SelectivePass::mark() {
 }
 
 bool SelectivePass::is_directional(uint16_t mask) const {
-  return !template_for_mask(mask).tmpl;
+  return !templates_.choice(mask).tmpl;
 }
 
 void SelectivePass::resolve_doublets() {
@@ -152,7 +153,7 @@ void SelectivePass::resolve_doublets() {
       const uint16_t mask = hex_split_mask(topo_, split_, h);
       if (!mask) continue;
       std::array<int, 12> adj{};
-      const int n = adjustment_edges(mask, is_directional(mask), adj);
+      const int n = adjustment_edges(templates_, mask, is_directional(mask), adj);
       for (int i = 0; i < n; ++i) {
         const int le = adj[i];
         const int32_t e = topo_.hex_edge_ids[h][le];
@@ -203,7 +204,7 @@ void SelectivePass::choose() {
   for (int32_t h : touched_) {
     const uint16_t mask = hex_split_mask(topo_, split_, h);
     if (!mask) continue;
-    const TemplateChoice c = template_for_mask(mask);
+    const TemplateChoice c = templates_.choice(mask);
     if (c.tmpl) {
       role_[h] = kElement;
       element_choice_[h] = c;
@@ -253,7 +254,7 @@ RefinementPlan SelectivePass::assemble() {
   for (int32_t h = 0; h < nh; ++h) {
     TemplateUse use{HexId{h}, nullptr, 0, role_[h] == kTarget};
     if (role_[h] == kTarget) {
-      use.tmpl = &template_1_27();
+      use.tmpl = &templates_.of(TemplateTag::t1_27);
     } else if (role_[h] == kElement) {
       use.tmpl = element_choice_[h].tmpl;
       use.symmetry = element_choice_[h].symmetry;
@@ -263,9 +264,9 @@ RefinementPlan SelectivePass::assemble() {
       // The table's positions are reference positions: the thesis' placement needs none, nor
       // the children's quality at them.
       const bool placed = options_.placement.method != PlacementMethod::trilinear;
-      plan.owned.push_back(selective_cells_template(cells, TemplateTag::directional, cells_refiner_,
-                                                    options_.placement.configuration_table,
-                                                    placed));
+      plan.owned.push_back(
+          selective_cells_template(cells, TemplateTag::directional, cells_refiner_, templates_,
+                                   options_.placement.configuration_table, placed));
       use.tmpl = plan.owned.back().get();
     } else {
       continue;
@@ -322,7 +323,7 @@ RefinementPlan SelectivePass::run() {
 
 RefinementPlan selective_plan(const HexMesh& mesh, const HexTopology& topology,
                               const std::vector<int32_t>& targets, const RefineOptions& options,
-                              RefineStats& stats) {
+                              RefineStats& stats, const TemplateLibrary& templates) {
   using namespace selective_detail;
   // A pass that meets an adjustment it can only avoid by splitting an input edge starts again
   // with that edge split (each attempt splits one more edge, so this ends).
@@ -332,7 +333,7 @@ RefinementPlan selective_plan(const HexMesh& mesh, const HexTopology& topology,
   for (;;) {
     const auto start = Clock::now();
     try {
-      SelectivePass pass(mesh, topology, targets, options, stats, forced);
+      SelectivePass pass(mesh, topology, targets, options, stats, forced, templates);
       RefinementPlan plan = pass.run();
       stats.input_edges_forced = static_cast<int64_t>(forced.size());
       stats.phase_seconds["restarted_passes"] = restarted_seconds;

@@ -213,6 +213,7 @@ void CellRefiner::refine(const TemplateCell& cell, const HexTemplate& t, int sym
 
 std::unique_ptr<HexTemplate> selective_cells_template(const std::vector<TemplateCell>& cells,
                                                       TemplateTag tag, const CellRefiner& refiner,
+                                                      const TemplateLibrary& templates,
                                                       bool configuration_table, bool placed) {
   auto t = std::make_unique<HexTemplate>();
   t->tag = tag;
@@ -236,7 +237,7 @@ std::unique_ptr<HexTemplate> selective_cells_template(const std::vector<Template
     t->children.push_back(child);
   }
   if (!moved) t->reference.clear();
-  if (configuration_table && placed) template_reference_from_configurations(*t);
+  if (configuration_table && placed) template_reference_from_configurations(*t, templates);
   template_compile(*t, 1, placed);
   return t;
 }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "algorithms/templates/template_engine.hpp"
+#include "algorithms/templates/template_reference.hpp"
 
 namespace hexrefine {
 
@@ -86,13 +87,13 @@ class CellRefiner {
 /// on the grid, so the engine keys them and neighbours share them; off-grid ones strictly inside),
 /// children the cells, tag `tag`; compiled for symmetry 0 only. Reference positions: the cells'
 /// composed `place` corners, the movable nodes (strictly inside, no alias target of `refiner`,
-/// which are TemplateNode::shared) from the committed table of directional configurations when
-/// it lists this one and `configuration_table` is set (template_reference.hpp). Without
+/// which are TemplateNode::shared) from the directional configurations of `templates` when
+/// they list this one and `configuration_table` is set (template_reference.hpp). Without
 /// `placed` (the thesis' trilinear placement) neither reference positions nor the children's
 /// quality at them are made: the template holds the exact positions alone.
-std::unique_ptr<HexTemplate> selective_cells_template(const std::vector<TemplateCell>& cells,
-                                                      TemplateTag tag, const CellRefiner& refiner,
-                                                      bool configuration_table = true,
-                                                      bool placed = true);
+std::unique_ptr<HexTemplate> selective_cells_template(
+    const std::vector<TemplateCell>& cells, TemplateTag tag, const CellRefiner& refiner,
+    const TemplateLibrary& templates = template_library_committed(),
+    bool configuration_table = true, bool placed = true);
 
 }  // namespace hexrefine

@@ -75,14 +75,17 @@ std::vector<NewEdge> template_new_edges(const HexTemplate& t) {
   return out;
 }
 
+/// By tag: which edges a step makes depends on the template's nodes and children alone, the
+/// same in every library.
 const std::vector<NewEdge>& new_edges_of(const HexTemplate* t) {
-  static const HexTemplate* keys[4] = {&template_1_5(), &template_1_4(), &template_1_3_adjust1(),
-                                       &template_1_3_adjust2()};
+  static const TemplateTag keys[4] = {TemplateTag::t1_5, TemplateTag::t1_4,
+                                      TemplateTag::t1_3_adjust1, TemplateTag::t1_3_adjust2};
   static const std::vector<NewEdge> lists[5] = {
-      template_new_edges(*keys[0]), template_new_edges(*keys[1]), template_new_edges(*keys[2]),
-      template_new_edges(*keys[3]), template_new_edges(template_1_3())};
+      template_new_edges(template_1_5()), template_new_edges(template_1_4()),
+      template_new_edges(template_1_3_adjust1()), template_new_edges(template_1_3_adjust2()),
+      template_new_edges(template_1_3())};
   for (int i = 0; i < 4; ++i)
-    if (keys[i] == t) return lists[i];
+    if (keys[i] == t->tag) return lists[i];
   return lists[4];
 }
 
@@ -95,7 +98,23 @@ void SelectivePass::rank() {
     cells_[di].push_back(cells_refiner_.cell_whole(directional_[di]));
   stats_.directional_hexes += nd;
   if (nd == 0) return;
-  // Groups (face-connected directional hexes).
+  const std::vector<int32_t> group = directional_groups();
+  const bool by_hex = options_.directional_order == DirectionalOrder::by_hex;
+  if (!options_.ranking) {
+    rounds_without_ranking(by_hex);
+    return;
+  }
+  std::vector<int32_t> rank_of;
+  const std::vector<Rank> members = ranks_build(group, rank_of);
+  stats_.ranks += static_cast<int64_t>(members.size());
+  if (by_hex)
+    rounds_by_hex(rank_of);
+  else
+    rounds_by_rank(members);
+}
+
+std::vector<int32_t> SelectivePass::directional_groups() {
+  const int32_t nd = static_cast<int32_t>(directional_.size());
   std::vector<int32_t> group(nd, -1);
   int64_t groups = 0;
   std::vector<int32_t> stack;
@@ -116,21 +135,25 @@ void SelectivePass::rank() {
     ++groups;
   }
   stats_.directional_groups += groups;
+  return group;
+}
 
-  const bool by_hex = options_.directional_order == DirectionalOrder::by_hex;
-  if (!options_.ranking) {
-    // Ablation: local x, y, z in turn, hex after hex, or each local direction for every hex.
-    if (by_hex) {
-      for (int32_t di = 0; di < nd; ++di)
-        for (int8_t d = 0; d < 3; ++d) rounds_.push_back({{di, d}});
-    } else {
-      for (int8_t d = 0; d < 3; ++d) {
-        rounds_.emplace_back();
-        for (int32_t di = 0; di < nd; ++di) rounds_.back().push_back({di, d});
-      }
+void SelectivePass::rounds_without_ranking(bool by_hex) {
+  const int32_t nd = static_cast<int32_t>(directional_.size());
+  if (by_hex) {
+    for (int32_t di = 0; di < nd; ++di)
+      for (int8_t d = 0; d < 3; ++d) rounds_.push_back({{di, d}});
+  } else {
+    for (int8_t d = 0; d < 3; ++d) {
+      rounds_.emplace_back();
+      for (int32_t di = 0; di < nd; ++di) rounds_.back().push_back({di, d});
     }
-    return;
   }
+}
+
+std::vector<SelectivePass::Rank> SelectivePass::ranks_build(const std::vector<int32_t>& group,
+                                                            std::vector<int32_t>& rank_of) {
+  const int32_t nd = static_cast<int32_t>(directional_.size());
   // Seeds: (hex, direction) by decreasing split count, then group, hex, direction.
   std::vector<std::array<int32_t, 4>> seeds;  // -count, group, di, d
   for (int32_t di = 0; di < nd; ++di) {
@@ -142,8 +165,8 @@ void SelectivePass::rank() {
     }
   }
   std::sort(seeds.begin(), seeds.end());
-  std::vector<int32_t> rank_of(3 * static_cast<size_t>(nd), -1);
-  std::vector<std::vector<std::pair<int32_t, int8_t>>> members;
+  rank_of.assign(3 * static_cast<size_t>(nd), -1);
+  std::vector<Rank> members;
   std::vector<std::pair<int32_t, int8_t>> queue;
   for (const auto& sd : seeds) {
     const int32_t di0 = sd[2];
@@ -174,20 +197,23 @@ void SelectivePass::rank() {
       }
     }
   }
-  stats_.ranks += static_cast<int64_t>(members.size());
-  if (by_hex) {
-    // The thesis' loop: each hex's directions by increasing rank, one step each, hex after hex.
-    for (int32_t di = 0; di < nd; ++di) {
-      std::array<int8_t, 3> order = {0, 1, 2};
-      std::sort(order.begin(), order.end(),
-                [&](int8_t a, int8_t b) { return rank_of[3 * di + a] < rank_of[3 * di + b]; });
-      for (int8_t d : order) rounds_.push_back({{di, d}});
-    }
-    return;
+  return members;
+}
+
+void SelectivePass::rounds_by_hex(const std::vector<int32_t>& rank_of) {
+  const int32_t nd = static_cast<int32_t>(directional_.size());
+  for (int32_t di = 0; di < nd; ++di) {
+    std::array<int8_t, 3> order = {0, 1, 2};
+    std::sort(order.begin(), order.end(),
+              [&](int8_t a, int8_t b) { return rank_of[3 * di + a] < rank_of[3 * di + b]; });
+    for (int8_t d : order) rounds_.push_back({{di, d}});
   }
+}
+
+void SelectivePass::rounds_by_rank(const std::vector<Rank>& members) {
   // A hex met twice by one rank (a self-intersecting sheet) refines those directions in turn.
-  std::vector<int8_t> seen_in_rank(nd, 0);
-  for (auto& m : members) {
+  std::vector<int8_t> seen_in_rank(directional_.size(), 0);
+  for (const auto& m : members) {
     std::vector<std::pair<int32_t, int8_t>> first, later;
     for (const auto& x : m) (seen_in_rank[x.first]++ ? later : first).push_back(x);
     for (const auto& x : m) seen_in_rank[x.first] = 0;
@@ -261,7 +287,7 @@ bool SelectivePass::decide(int32_t di, int axis, std::vector<Decision>& out) {
       if (d.split[le] && hex_edge_axis[le] == k) mask |= static_cast<uint16_t>(1u << le);
     }
     if (k < 0 || !mask) continue;
-    d.choice = template_for_mask(mask);
+    d.choice = templates_.choice(mask);
     if (c.collapsed || !c.exact)
       throw OperationError("selective_refine: hex " + std::to_string(c.hex) +
                            ": a sub-hex next to an adjustment needs further refinement (not "

@@ -59,16 +59,19 @@ inline SegmentKey segment_key(const NodeKey& a, const NodeKey& b) {
 
 class SelectivePass {
  public:
-  /// `forced_splits`: input edges split from the outset (found by earlier attempts).
+  /// `forced_splits`: input edges split from the outset (found by earlier attempts); every
+  /// template from `templates`.
   SelectivePass(const HexMesh& mesh, const HexTopology& topology,
                 const std::vector<int32_t>& targets, const RefineOptions& options,
-                RefineStats& stats, const std::vector<int32_t>& forced_splits)
+                RefineStats& stats, const std::vector<int32_t>& forced_splits,
+                const TemplateLibrary& templates)
       : mesh_(mesh),
         topo_(topology),
         targets_(targets),
         options_(options),
         stats_(stats),
         forced_splits_(forced_splits),
+        templates_(templates),
         cells_refiner_(mesh, topology) {}
 
   /// Decides the pass (Parrish, Table 5-1) and returns its plan.
@@ -98,8 +101,27 @@ class SelectivePass {
   void register_adjustments(const TemplateCell& cell, const TemplateChoice& c);
   RefinementPlan assemble();
 
+  /// The (directional index, input axis) pairs of one rank, in the order the ranking met them.
+  using Rank = std::vector<std::pair<int32_t, int8_t>>;
+
   // selective_directional.cpp
+  /// The thesis' ranking system: each directional hex's cells start whole; the
+  /// rounds of (hex, direction) pairs in processing order, by rank (or, without ranking, local
+  /// x, y, z), hex after hex or rank after rank (RefineOptions::directional_order).
   void rank();
+  /// Per directional index: its group (face-connected directional hexes), counted in stats.
+  std::vector<int32_t> directional_groups();
+  /// The rounds of the ablation without ranking: local x, y, z in turn, hex after hex
+  /// (`by_hex`) or each local direction for every hex.
+  void rounds_without_ranking(bool by_hex);
+  /// The ranks: seeds by decreasing split count, then group, hex, direction, each grown through
+  /// opposite edges of adjacent faces; rank_of[3 * di + d] the rank of pair (di, d).
+  std::vector<Rank> ranks_build(const std::vector<int32_t>& group, std::vector<int32_t>& rank_of);
+  /// The thesis' loop: each hex's directions by increasing rank, one step each, hex after hex.
+  void rounds_by_hex(const std::vector<int32_t>& rank_of);
+  /// Rank after rank; a hex met twice by one rank (a self-intersecting sheet) refines those
+  /// directions in successive rounds.
+  void rounds_by_rank(const std::vector<Rank>& members);
   void refine_directional();
   bool cell_edge_split(const TemplateCell& c, int le) const;
   /// The input edge that local edge `le` of cell `c` lies on, or -1.
@@ -115,6 +137,7 @@ class SelectivePass {
   const RefineOptions& options_;
   RefineStats& stats_;
   const std::vector<int32_t>& forced_splits_;
+  const TemplateLibrary& templates_;
   CellRefiner cells_refiner_;
   std::vector<uint8_t> split_;  // per input edge
   std::vector<uint8_t> role_;   // per input hex

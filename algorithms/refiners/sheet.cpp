@@ -99,7 +99,8 @@ void marking_seed(const HexMesh& mesh, const std::vector<int32_t>& targets, Shee
 // decides all candidates on the marks of the previous wave, then adds them together. (Adding
 // one hex at a time would depend on the visiting order: a hex can get all its nodes marked by
 // its neighbours' growth and be fully refined without ever being added, which changes
-// added_targets; the thesis' L-shaped case adds exactly the 810 non-target hexes.)
+// added_targets; the waves add exactly the thesis' count on its L-shaped case, which
+// tests/algorithms/refiners/test_sheet.cpp asserts.)
 void marking_grow(const HexMesh& mesh, const HexTopology& topology,
                   const std::vector<int32_t>& targets, SheetMarking& m) {
   std::vector<uint8_t> queued(mesh.hexes.size(), 0);
@@ -161,6 +162,92 @@ struct SheetPass {
   }
 };
 
+/// The hexes with a split edge (ascending; all of them touch a marked node) into
+/// pass.region_hexes; returns their split masks (one per region hex).
+std::vector<uint16_t> region_find(const HexMesh& mesh, const HexTopology& topology,
+                                  SheetPass& pass) {
+  std::vector<uint16_t> masks;
+  std::vector<uint8_t> seen(mesh.hexes.size(), 0);
+  for (int32_t v = 0; v < mesh.point_count(); ++v) {
+    if (!pass.marking.node_marked[v]) continue;
+    for (int32_t g : node_hexes(topology, v)) {
+      if (seen[g]) continue;
+      seen[g] = 1;
+      if (hex_split_mask(mesh, pass.marking.node_marked, g)) pass.region_hexes.push_back(g);
+    }
+  }
+  std::sort(pass.region_hexes.begin(), pass.region_hexes.end());
+  for (int32_t h : pass.region_hexes)
+    masks.push_back(hex_split_mask(mesh, pass.marking.node_marked, h));
+  return masks;
+}
+
+/// Self-intersections: the dual sheet of one direction of a refined hex is also the sheet of
+/// another of its directions (Harris' special case). Counted on the whole dual sheets; refused
+/// (OperationError naming the sheet and hexes) only where one piece must refine a hex in two
+/// directions without splitting all its edges.
+void self_intersections_check(const HexMesh& mesh, const HexTopology& topology,
+                              const SheetPass& pass, const std::vector<uint16_t>& masks,
+                              RefineStats& stats) {
+  const DualSheets sheets = dual_build(mesh, topology, DualParts::sheets);
+  std::vector<int32_t> refused;
+  int32_t refused_piece = -1;
+  for (size_t i = 0; i < pass.region_hexes.size(); ++i) {
+    const auto& s = sheets.hex_sheet[pass.region_hexes[i]];
+    if (s[0] == s[1] || s[1] == s[2] || s[0] == s[2]) ++stats.self_intersection_cases;
+    const auto& o = pass.pieces.hex_piece[i];
+    // All edges split: the piece's directions are refined together by 1-9 (or 1-27).
+    if (masks[i] == 0xFFF) continue;
+    for (int a = 0; a < 3; ++a)
+      for (int b = a + 1; b < 3; ++b)
+        if (o[a] >= 0 && o[a] == o[b]) {
+          if (refused_piece < 0) refused_piece = o[a];
+          const int32_t h = pass.region_hexes[i];
+          if (o[a] == refused_piece && (refused.empty() || refused.back() != h))
+            refused.push_back(h);
+        }
+  }
+  if (!refused.empty())
+    throw OperationError(
+        "sheet refinement: the dual sheet of edge " + pass.piece_name(topology, refused_piece) +
+        " crosses itself in hexes " + hex_list(refused) +
+        ", which it must refine in two directions within one sheet pass with transition "
+        "templates; that case of a self-intersecting sheet is not handled by the sheet refiner "
+        "(only fully refined hexes are: 1-9)");
+}
+
+/// Rounds: first-fit colouring of the pieces (pass.color, pass.round_count); two pieces
+/// conflict when they share a hex.
+void pieces_color(SheetPass& pass) {
+  const int32_t piece_count = pass.pieces.piece_count();
+  pass.color.assign(piece_count, -1);
+  std::vector<int32_t> offsets(piece_count + 1, 0);
+  for (const auto& o : pass.pieces.hex_piece)
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        if (a != b && o[a] >= 0 && o[b] >= 0) ++offsets[o[a] + 1];
+  for (int32_t p = 0; p < piece_count; ++p) offsets[p + 1] += offsets[p];
+  std::vector<int32_t> adjacent(offsets[piece_count]);
+  std::vector<int32_t> cursor(offsets.begin(), offsets.end() - 1);
+  for (const auto& o : pass.pieces.hex_piece)
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        if (a != b && o[a] >= 0 && o[b] >= 0) adjacent[cursor[o[a]]++] = o[b];
+  std::vector<int32_t> stamp;  // stamp[c] == p: colour c is used by a neighbour of p
+  for (int32_t p = 0; p < piece_count; ++p) {
+    for (int32_t i = offsets[p]; i < offsets[p + 1]; ++i) {
+      const int32_t c = pass.color[adjacent[i]];
+      if (c < 0) continue;
+      if (c >= static_cast<int32_t>(stamp.size())) stamp.resize(c + 1, -1);
+      stamp[c] = p;
+    }
+    int32_t c = 0;
+    while (c < static_cast<int32_t>(stamp.size()) && stamp[c] == p) ++c;
+    pass.color[p] = c;
+    pass.round_count = std::max(pass.round_count, c + 1);
+  }
+}
+
 SheetPass sheet_pass_prepare(const HexMesh& mesh, const HexTopology& topology,
                              const std::vector<int32_t>& targets, bool one_sheet_per_round,
                              RefineStats& stats) {
@@ -175,85 +262,11 @@ SheetPass sheet_pass_prepare(const HexMesh& mesh, const HexTopology& topology,
   stats.phase_seconds["growth"] += seconds_since(t_growth);
 
   const auto t_sheets = Clock::now();
-  // Hexes with a split edge; all of them touch a marked node.
-  std::vector<uint16_t> masks;
-  {
-    std::vector<uint8_t> seen(mesh.hexes.size(), 0);
-    for (int32_t v = 0; v < mesh.point_count(); ++v) {
-      if (!pass.marking.node_marked[v]) continue;
-      for (int32_t g : node_hexes(topology, v)) {
-        if (seen[g]) continue;
-        seen[g] = 1;
-        if (hex_split_mask(mesh, pass.marking.node_marked, g)) pass.region_hexes.push_back(g);
-      }
-    }
-    std::sort(pass.region_hexes.begin(), pass.region_hexes.end());
-    for (int32_t h : pass.region_hexes)
-      masks.push_back(hex_split_mask(mesh, pass.marking.node_marked, h));
-  }
+  const std::vector<uint16_t> masks = region_find(mesh, topology, pass);
   pass.pieces = dual_sheet_pieces(topology, pass.region_hexes, masks);
   const int32_t piece_count = pass.pieces.piece_count();
-
-  // Self-intersections: the dual sheet of one direction of a refined hex is also the sheet of
-  // another of its directions (Harris' special case). Counted on the whole dual sheets; refused
-  // only where one piece must refine a hex in two directions without splitting all its edges.
-  {
-    const DualSheets sheets = dual_build(mesh, topology, DualParts::sheets);
-    std::vector<int32_t> refused;
-    int32_t refused_piece = -1;
-    for (size_t i = 0; i < pass.region_hexes.size(); ++i) {
-      const auto& s = sheets.hex_sheet[pass.region_hexes[i]];
-      if (s[0] == s[1] || s[1] == s[2] || s[0] == s[2]) ++stats.self_intersection_cases;
-      const auto& o = pass.pieces.hex_piece[i];
-      // All edges split: the piece's directions are refined together by 1-9 (or 1-27).
-      if (masks[i] == 0xFFF) continue;
-      for (int a = 0; a < 3; ++a)
-        for (int b = a + 1; b < 3; ++b)
-          if (o[a] >= 0 && o[a] == o[b]) {
-            if (refused_piece < 0) refused_piece = o[a];
-            const int32_t h = pass.region_hexes[i];
-            if (o[a] == refused_piece && (refused.empty() || refused.back() != h))
-              refused.push_back(h);
-          }
-    }
-    if (!refused.empty())
-      throw OperationError(
-          "sheet refinement: the dual sheet of edge " + pass.piece_name(topology, refused_piece) +
-          " crosses itself in hexes " + hex_list(refused) +
-          ", which it must refine in two directions within one sheet pass with transition "
-          "templates; that case of a self-intersecting sheet is not handled by the sheet refiner "
-          "(only fully refined hexes are: 1-9)");
-  }
-
-  // Rounds: first-fit colouring of the pieces; two pieces conflict when they share a hex.
-  pass.color.assign(piece_count, -1);
-  {
-    std::vector<int32_t> offsets(piece_count + 1, 0);
-    for (const auto& o : pass.pieces.hex_piece)
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-          if (a != b && o[a] >= 0 && o[b] >= 0) ++offsets[o[a] + 1];
-    for (int32_t p = 0; p < piece_count; ++p) offsets[p + 1] += offsets[p];
-    std::vector<int32_t> adjacent(offsets[piece_count]);
-    std::vector<int32_t> cursor(offsets.begin(), offsets.end() - 1);
-    for (const auto& o : pass.pieces.hex_piece)
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-          if (a != b && o[a] >= 0 && o[b] >= 0) adjacent[cursor[o[a]]++] = o[b];
-    std::vector<int32_t> stamp;  // stamp[c] == p: colour c is used by a neighbour of p
-    for (int32_t p = 0; p < piece_count; ++p) {
-      for (int32_t i = offsets[p]; i < offsets[p + 1]; ++i) {
-        const int32_t c = pass.color[adjacent[i]];
-        if (c < 0) continue;
-        if (c >= static_cast<int32_t>(stamp.size())) stamp.resize(c + 1, -1);
-        stamp[c] = p;
-      }
-      int32_t c = 0;
-      while (c < static_cast<int32_t>(stamp.size()) && stamp[c] == p) ++c;
-      pass.color[p] = c;
-      pass.round_count = std::max(pass.round_count, c + 1);
-    }
-  }
+  self_intersections_check(mesh, topology, pass, masks, stats);
+  pieces_color(pass);
   if (one_sheet_per_round) {
     std::iota(pass.color.begin(), pass.color.end(), 0);
     pass.round_count = piece_count;
@@ -344,7 +357,7 @@ SheetMarking sheet_mark(const HexMesh& mesh, const HexTopology& topology, const 
 
 RefinementPlan sheet_plan(const HexMesh& mesh, const HexTopology& topology,
                           const std::vector<int32_t>& targets, const RefineOptions& options,
-                          RefineStats& stats) {
+                          RefineStats& stats, const TemplateLibrary& templates) {
   const SheetPass pass = sheet_pass_prepare(mesh, topology, targets, false, stats);
   const auto t_composites = Clock::now();
   // Configuration: 8 mark bits, then per axis 2 bits of (rank + 1).
@@ -379,7 +392,7 @@ RefinementPlan sheet_plan(const HexMesh& mesh, const HexTopology& topology,
     const uint32_t key = marks | (rank[0] + 1) << 8 | (rank[1] + 1) << 10 | (rank[2] + 1) << 12;
     if (!composites[key]) {
       composites[key] =
-          sheet_composite_build(marks, rank, h, options.placement.configuration_table,
+          sheet_composite_build(marks, rank, h, templates, options.placement.configuration_table,
                                 options.placement.method != PlacementMethod::trilinear);
       if (!composites[key]->positive)
         throw OperationError("sheet refinement: the refinement of input hex " + std::to_string(h) +

@@ -59,10 +59,11 @@ using SheetRoundObserver = std::function<void(const HexMesh& mesh, int round)>;
 /// stats.self_intersection_cases counts the refined hexes a dual sheet crosses itself in. Throws
 /// OperationError naming the sheet and hexes for a case it refuses (a sheet crossing itself in a
 /// transition hex that it must refine in two directions, or neighbours whose sheets would split
-/// their shared face in different passes).
+/// their shared face in different passes). The composites' reference positions and
+/// configurations are `templates`'.
 RefinementPlan sheet_plan(const HexMesh& mesh, const HexTopology& topology,
                           const std::vector<int32_t>& targets, const RefineOptions& options,
-                          RefineStats& stats);
+                          RefineStats& stats, const TemplateLibrary& templates);
 
 /// refine(refine_method("sheet"), mesh, targets, options).
 RefineResult sheet_refine(const HexMesh& mesh, const Targets& targets,

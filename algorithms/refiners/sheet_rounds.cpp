@@ -150,7 +150,7 @@ const Orientation* sheet_orientation(uint16_t split_mask) {
 
 RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int32_t>& color,
                         int32_t round, const std::function<std::string(int32_t)>& piece_name,
-                        TemplatePositions positions) {
+                        TemplatePositions positions, const TemplateLibrary& templates) {
   const int32_t count = mesh.hex_count();
   const HexTopology rt = topology_build(mesh);
   RefinementPlan plan;
@@ -191,7 +191,8 @@ RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int3
                            " directions) in the sheet of edge " + piece_name(piece));
     orientation_of[h] = o;
     axes_of[h] = o->axes;
-    plan.uses.push_back({HexId{h}, o->choice.tmpl, o->choice.symmetry, false});
+    // The orientation's template as `templates` has it (its own reference positions).
+    plan.uses.push_back({HexId{h}, &templates.of(o->choice.tmpl->tag), o->choice.symmetry, false});
   }
   // Conformity by construction needs every hex around a split edge to split it in this round.
   for (const TemplateUse& u : plan.uses) {
@@ -248,8 +249,9 @@ RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int3
 
 std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
                                                       const std::array<int8_t, 3>& rank,
-                                                      int32_t input_hex, bool configuration_table,
-                                                      bool placed) {
+                                                      int32_t input_hex,
+                                                      const TemplateLibrary& templates,
+                                                      bool configuration_table, bool placed) {
   const std::vector<int32_t> color = {0, 1, 2};
   const int32_t rounds = 1 + std::max({rank[0], rank[1], rank[2]});
   auto c = std::make_unique<SheetComposite>();
@@ -274,7 +276,7 @@ std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
               if (rank[k] == piece) axes += "xyz"[k];
             return "through local axes " + axes + " of input hex " + std::to_string(input_hex);
           },
-          positions);
+          positions, templates);
       if (!count) continue;
       c->counts.created += r.created;
       c->counts.deleted += r.deleted;
@@ -295,7 +297,7 @@ std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
     t.children.push_back(child);
     c->positive = c->positive && hex_corners_positive(hex_points(cube, h));
   }
-  if (configuration_table && placed) template_reference_from_configurations(t);
+  if (configuration_table && placed) template_reference_from_configurations(t, templates);
   template_compile(t, 1, placed);
   composite_face_hashes(t, c->face_hash);
   return c;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "algorithms/templates/template_engine.hpp"
+#include "algorithms/templates/template_reference.hpp"
 #include "mesh/hex_mesh.hpp"
 
 namespace hexrefine::sheet_detail {
@@ -50,19 +51,22 @@ struct RoundState {
 /// `round` (color[piece]), with the directional template its split edges (node marks) call for;
 /// children inherit the pieces of the parent axes their edges run along, new nodes inside split
 /// edges are marked. `piece_name` describes a piece for messages. New nodes go to their parent's
-/// trilinear map of the templates' `positions` (what is created does not depend on it). Throws
+/// trilinear map of the `positions` of the templates of `templates` (what is created does not
+/// depend on either). Throws
 /// OperationError where a hex has no directional template or two hexes around a split edge would
 /// not split it in the same round.
 RoundCounts sheet_round(HexMesh& mesh, RoundState& state, const std::vector<int32_t>& color,
                         int32_t round, const std::function<std::string(int32_t)>& piece_name,
-                        TemplatePositions positions = TemplatePositions::exact);
+                        TemplatePositions positions = TemplatePositions::exact,
+                        const TemplateLibrary& templates = template_library_committed());
 
 /// What the rounds do to one hex with corner marks `marks` (bit v: vertex v marked) whose local
 /// axis k is refined in round rank[k] (-1: never), as one template (TemplateTag::sheet, on the
 /// exact grid, compiled for symmetry 0; its reference positions the rounds run again with the
-/// directional templates' reference positions, so the face rules of template_reference.hpp
-/// compose as in the Selective Approach's directional hexes; its movable nodes from the table
-/// of configurations when `configuration_table` is set and the table lists it; without `placed`,
+/// directional templates' reference positions in `templates`, so the face rules of
+/// template_reference.hpp compose as in the Selective Approach's directional hexes; its movable
+/// nodes from the configurations of `templates` when `configuration_table` is set and they list
+/// it; without `placed`,
 /// the thesis' trilinear placement, no reference positions and no children's quality at them), with
 /// the hashes of
 /// its six face subdivisions per face frame (face_hash[lf][2 * i0 + (step == 1 ? 0 : 1)]: origin at
@@ -74,11 +78,9 @@ struct SheetComposite {
   bool positive = true;  ///< every child positive in the reference cube
   std::array<std::array<uint64_t, 8>, 6> face_hash{};
 };
-std::unique_ptr<SheetComposite> sheet_composite_build(uint8_t marks,
-                                                      const std::array<int8_t, 3>& rank,
-                                                      int32_t input_hex,
-                                                      bool configuration_table = true,
-                                                      bool placed = true);
+std::unique_ptr<SheetComposite> sheet_composite_build(
+    uint8_t marks, const std::array<int8_t, 3>& rank, int32_t input_hex,
+    const TemplateLibrary& templates, bool configuration_table = true, bool placed = true);
 
 /// Hash of an unrefined face (any frame).
 uint64_t sheet_whole_face_hash();

@@ -244,8 +244,6 @@ HexTemplate template_from_table(TemplateTag tag, std::span<const NodeRow> nodes,
     t.nodes.push_back({{n.x / 6.0, n.y / 6.0, n.z / 6.0}, n.adjustment_edge, n.adjustment_index});
   t.children.assign(children.begin(), children.end());
   template_compute_child_axes(t);
-  template_reference_from_table(t);
-  template_compile(t);
   return t;
 }
 
@@ -306,25 +304,50 @@ std::array<double, 8> hex_trilinear_weights(const std::array<double, 3>& p) {
   return w;
 }
 
-const HexTemplate& template_1_27() {
-  static HexTemplate t =
-      template_from_table(TemplateTag::t1_27, grid_1_27.nodes, grid_1_27.children);
+HexTemplate template_standard_exact(TemplateTag tag) {
+  switch (tag) {
+    case TemplateTag::t1_27:
+      return template_from_table(tag, grid_1_27.nodes, grid_1_27.children);
+    case TemplateTag::t1_13:
+      return template_from_table(tag, nodes_1_13, children_1_13);
+    case TemplateTag::t1_5:
+      return template_from_table(tag, nodes_1_5, children_1_5);
+    case TemplateTag::t1_4:
+      return template_from_table(tag, nodes_1_4, children_1_4);
+    case TemplateTag::t1_3:
+      return template_from_table(tag, grid_1_3.nodes, grid_1_3.children);
+    case TemplateTag::t1_3_adjust1:
+      return template_from_table(tag, nodes_1_3_adjust1, children_adjusted);
+    case TemplateTag::t1_3_adjust2:
+      return template_from_table(tag, nodes_1_3_adjust2, children_adjusted);
+    case TemplateTag::t1_9:
+      return template_from_table(tag, grid_1_9.nodes, grid_1_9.children);
+    default:
+      throw OperationError(std::string("no standard template ") + template_tag_name(tag));
+  }
+}
+
+HexTemplate template_standard_build(TemplateTag tag, const TemplateReferenceTable& table) {
+  HexTemplate t = template_standard_exact(tag);
+  template_reference_from_table(t, table);
+  template_compile(t);
   return t;
+}
+
+const HexTemplate& template_1_27() {
+  return template_library_committed().of(TemplateTag::t1_27);
 }
 
 const HexTemplate& template_1_9() {
-  static HexTemplate t = template_from_table(TemplateTag::t1_9, grid_1_9.nodes, grid_1_9.children);
-  return t;
+  return template_library_committed().of(TemplateTag::t1_9);
 }
 
 const HexTemplate& template_1_3() {
-  static HexTemplate t = template_from_table(TemplateTag::t1_3, grid_1_3.nodes, grid_1_3.children);
-  return t;
+  return template_library_committed().of(TemplateTag::t1_3);
 }
 
 const HexTemplate& template_1_13() {
-  static HexTemplate t = template_from_table(TemplateTag::t1_13, nodes_1_13, children_1_13);
-  return t;
+  return template_library_committed().of(TemplateTag::t1_13);
 }
 
 HexTemplate template_1_13_build(double interior_height) {
@@ -339,45 +362,23 @@ HexTemplate template_1_13_build(double interior_height) {
 }
 
 const HexTemplate& template_1_5() {
-  static HexTemplate t = template_from_table(TemplateTag::t1_5, nodes_1_5, children_1_5);
-  return t;
+  return template_library_committed().of(TemplateTag::t1_5);
 }
 
 const HexTemplate& template_1_4() {
-  static HexTemplate t = template_from_table(TemplateTag::t1_4, nodes_1_4, children_1_4);
-  return t;
+  return template_library_committed().of(TemplateTag::t1_4);
 }
 
 const HexTemplate& template_1_3_adjust1() {
-  static HexTemplate t =
-      template_from_table(TemplateTag::t1_3_adjust1, nodes_1_3_adjust1, children_adjusted);
-  return t;
+  return template_library_committed().of(TemplateTag::t1_3_adjust1);
 }
 
 const HexTemplate& template_1_3_adjust2() {
-  static HexTemplate t =
-      template_from_table(TemplateTag::t1_3_adjust2, nodes_1_3_adjust2, children_adjusted);
-  return t;
-}
-
-void template_set_reference(TemplateTag tag, std::vector<std::array<double, 3>> reference) {
-  const HexTemplate* found = nullptr;
-  for (const HexTemplate* t :
-       {&template_1_27(), &template_1_13(), &template_1_5(), &template_1_4(), &template_1_3(),
-        &template_1_3_adjust1(), &template_1_3_adjust2(), &template_1_9()})
-    if (t->tag == tag) found = t;
-  if (!found)
-    throw OperationError(std::string("template_set_reference: no standard template ") +
-                         template_tag_name(tag));
-  // The standard templates are function-local statics that are not const: this is their one
-  // writer.
-  HexTemplate& t = const_cast<HexTemplate&>(*found);
-  t.reference = std::move(reference);
-  template_compile(t);
+  return template_library_committed().of(TemplateTag::t1_3_adjust2);
 }
 
 bool template_is_adjusted(const HexTemplate& tmpl) {
-  return &tmpl == &template_1_3_adjust1() || &tmpl == &template_1_3_adjust2();
+  return tmpl.tag == TemplateTag::t1_3_adjust1 || tmpl.tag == TemplateTag::t1_3_adjust2;
 }
 
 uint16_t template_split_edges(const HexTemplate& tmpl) {
@@ -396,25 +397,28 @@ uint16_t template_split_edges(const HexTemplate& tmpl) {
   return mask;
 }
 
-TemplateChoice template_for_mask(uint16_t mask, TemplateSet set) {
-  using Table = std::array<TemplateChoice, 4096>;
-  auto build = [](std::initializer_list<const HexTemplate*> templates) {
-    Table out{};
-    for (const HexTemplate* t : templates) {
-      const uint16_t canonical = template_split_edges(*t);
-      for (int s = 0; s < 48; ++s) {
-        const uint16_t m = cube_symmetry_edge_mask(cube_symmetries()[s], canonical);
-        if (!out[m].tmpl) out[m] = {t, static_cast<int8_t>(s)};
-      }
+void template_mask_table_fill(std::span<const HexTemplate* const> templates,
+                              TemplateMaskTable& out) {
+  for (const HexTemplate* t : templates) {
+    const uint16_t canonical = template_split_edges(*t);
+    for (int s = 0; s < 48; ++s) {
+      const uint16_t m = cube_symmetry_edge_mask(cube_symmetries()[s], canonical);
+      if (!out[m].tmpl) out[m] = {t, static_cast<int8_t>(s)};
     }
-    return out;
-  };
-  static const std::array<Table, 2> tables = {
-      build({&template_1_27(), &template_1_13(), &template_1_5(), &template_1_4(), &template_1_3(),
-             &template_1_3_adjust1(), &template_1_3_adjust2()}),
-      build({&template_1_3(), &template_1_4(), &template_1_5(), &template_1_9(), &template_1_27()}),
-  };
-  return tables[static_cast<int>(set)][mask & 0xFFF];
+  }
+}
+
+std::vector<TemplateTag> template_set_tags(TemplateSet set) {
+  if (set == TemplateSet::element_by_element)
+    return {TemplateTag::t1_27,       TemplateTag::t1_13, TemplateTag::t1_5,
+            TemplateTag::t1_4,        TemplateTag::t1_3,  TemplateTag::t1_3_adjust1,
+            TemplateTag::t1_3_adjust2};
+  return {TemplateTag::t1_3, TemplateTag::t1_4, TemplateTag::t1_5, TemplateTag::t1_9,
+          TemplateTag::t1_27};
+}
+
+TemplateChoice template_for_mask(uint16_t mask, TemplateSet set) {
+  return template_library_committed().choice(mask, set);
 }
 
 void template_compute_child_axes(HexTemplate& t) {

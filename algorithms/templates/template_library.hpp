@@ -24,6 +24,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "algorithms/templates/cube_symmetry.hpp"
@@ -142,7 +143,8 @@ void template_compute_child_axes(HexTemplate& tmpl);
 /// neighbour), or if tmpl.reference is neither empty nor one position per node.
 void template_compile(HexTemplate& tmpl, int symmetry_count = 48, bool child_quality = true);
 
-/// The standard templates in canonical orientation, compiled for all 48 symmetries.
+/// The standard templates in canonical orientation, compiled for all 48 symmetries, at the
+/// committed table's reference positions (template_library_committed, template_reference.hpp).
 /// 1-27: all twelve edges split; 3 x 3 x 3 children.
 const HexTemplate& template_1_27();
 /// 1-13: the four edges of face z=0 split (e0..e3); 13 children.
@@ -161,22 +163,28 @@ const HexTemplate& template_1_3_adjust2();
 /// template): where a dual sheet crosses itself in a fully refined hex (sheet refinement).
 const HexTemplate& template_1_9();
 
-/// Replaces the reference positions of the standard template tagged `tag` (empty: the exact
-/// ones) and compiles it again. For the offline optimisation (template_reference_install) only:
-/// not thread-safe, and no refinement may run meanwhile. Throws OperationError for a tag with no
-/// standard template or a wrong count.
-void template_set_reference(TemplateTag tag, std::vector<std::array<double, 3>> reference);
+/// The tags of the standard templates, in the order of TemplateLibrary::standard.
+inline constexpr std::array<TemplateTag, 8> template_standard_tags = {
+    TemplateTag::t1_27, TemplateTag::t1_13,        TemplateTag::t1_5,         TemplateTag::t1_4,
+    TemplateTag::t1_3,  TemplateTag::t1_3_adjust1, TemplateTag::t1_3_adjust2, TemplateTag::t1_9};
+
+/// The standard template tagged `tag` from its literal table: nodes, children and child axes,
+/// every node at its exact position (reference empty), not compiled. Throws OperationError for
+/// a tag with no standard template.
+HexTemplate template_standard_exact(TemplateTag tag);
 
 /// 1-13 with its four interior nodes at height `interior_height` in (0, 1) (for quality scans;
 /// reference positions the exact ones).
 HexTemplate template_1_13_build(double interior_height);
 /// Height of the four interior nodes of 1-13. The minimum scaled Jacobian is 4/13 = 0.3077 (the
-/// thesis' L-shaped value) for every height in (0, 0.27], fixed by the corner children; above
-/// that it drops (0.5 is degenerate). 1/6 lies inside the plateau and on the sixths grid.
+/// thesis' L-shaped value) on a plateau of low heights, fixed by the corner children; above it
+/// it drops (0.5 is degenerate; the scan: results/methods.md, "Template constants"). 1/6 lies
+/// inside the plateau and on the sixths grid.
 inline constexpr double template_1_13_interior_height = 1.0 / 6.0;
 /// Depth q of adjustment nodes: (x, q, q) for an adjustment at edge (y1, z1). A multiple of 1/6
 /// so that sub-hexes of directional refinement keep exact reference positions. Chosen, not given
-/// by the thesis (its Figure E-21 is missing): 5/6 gives the L-shaped case 0.3077, 2/3 0.2582.
+/// by the thesis (its Figure E-21 is missing): 5/6 gives the L-shaped case a higher minimum than
+/// 2/3 (results/methods.md, "Template constants").
 inline constexpr double template_adjustment_depth = 5.0 / 6.0;
 
 /// Which templates a split-edge pattern may call for.
@@ -191,16 +199,29 @@ enum class TemplateSet : uint8_t {
 };
 
 /// The template and symmetry for a split-edge mask (bit e = local edge e split); tmpl is nullptr
-/// for mask 0 and for masks the set has no template for. One table of 4096 entries per set,
-/// built once over the set's templates and the 48 symmetries (the first symmetry that maps the
-/// template's canonical mask onto the mask wins).
+/// for mask 0 and for masks the set has no template for.
 struct TemplateChoice {
   const HexTemplate* tmpl = nullptr;
   int8_t symmetry = 0;
 };
+/// One choice per split-edge mask (4096).
+using TemplateMaskTable = std::array<TemplateChoice, 4096>;
+
+/// Fills `table` (every choice empty on entry) as the mask table of a set's templates
+/// (`templates`, in order; they must outlive it): for each template and each of the 48
+/// symmetries, the mask the symmetry maps its canonical mask onto; the first template and
+/// symmetry to reach a mask win. In place: a table is 64 KiB, built where it stays.
+void template_mask_table_fill(std::span<const HexTemplate* const> templates,
+                              TemplateMaskTable& table);
+
+/// The templates of `set` in the order template_mask_table_fill takes them.
+std::vector<TemplateTag> template_set_tags(TemplateSet set);
+
+/// The committed library's choice for `mask` (TemplateLibrary::choice).
 TemplateChoice template_for_mask(uint16_t mask, TemplateSet set = TemplateSet::element_by_element);
 
-/// True for the two adjusted 1-3 templates (their adjustment nodes merge neighbours' faces).
+/// True for the two adjusted 1-3 templates (their adjustment nodes merge neighbours' faces), of
+/// any library (by tag).
 bool template_is_adjusted(const HexTemplate& tmpl);
 
 /// Which position of each template node: the exact one (TemplateNode::ref, the thesis') or the

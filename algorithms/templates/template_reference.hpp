@@ -2,10 +2,10 @@
 /// \file
 /// Reference positions of template nodes: where, in the unit cube, the new nodes of a template
 /// go so that the worst child is as good as it can be (the thesis' positions, thirds, halves and
-/// sixths, give 1-13 4/13 = 0.3077 on the unit cube). Computed offline by
-/// template_reference_optimize (`hexrefine templates --optimize`), written as a C++ table
-/// (template_reference_table.inc, committed) that the library reads when it builds its
-/// templates; the reference placement (node_placement.hpp) maps them through each parent's
+/// sixths, give 1-13 4/13 = 0.3077 on the unit cube). Computed offline by the template optimiser
+/// (`hexrefine templates --optimize`, experiments/cli/template_optimize.hpp), written as a C++
+/// table (template_reference_table.inc, committed) that the library reads when it builds its
+/// templates (TemplateLibrary); the reference placement maps them through each parent's
 /// trilinear map, at the cost of the thesis' placement.
 ///
 /// Conformity by construction. A node is shared by every hex around the edge or face it
@@ -41,6 +41,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -80,53 +81,18 @@ bool template_node_movable(const HexTemplate& tmpl, size_t i);
 void template_reference_set(HexTemplate& tmpl, const ReferenceRules& rules,
                             std::span<const std::array<double, 3>> interior);
 
-/// Sets tmpl.reference from the committed table for a standard template (by its tag; the
-/// templates the table does not list keep their exact positions). Does not compile.
-void template_reference_from_table(HexTemplate& tmpl);
-
-/// A template's configuration up to the 48 cube symmetries: two 64-bit hashes of its nodes'
-/// exact positions and its children in a canonical frame (the symmetry `symmetry` maps the
-/// template into it), and the order of the nodes there (order[k]: the node at canonical rank
-/// k, nodes sorted by their position in the canonical frame).
-struct TemplateConfiguration {
-  std::array<uint64_t, 2> hash{};
-  int8_t symmetry = 0;
-  std::vector<int32_t> order;
-};
-
-/// The configuration of a template in canonical orientation (its nodes' `ref`; it need not be
-/// compiled).
-TemplateConfiguration template_configuration(const HexTemplate& tmpl);
-
-/// Sets the movable nodes' reference positions of a directional configuration (a plan-owned
-/// template whose tmpl.reference holds the composed positions) from the committed table, if
-/// the table lists its configuration; returns whether it did. Does not compile.
-bool template_reference_from_configurations(HexTemplate& tmpl);
-
-/// Maximises the minimum scaled Jacobian of tmpl's children on the unit cube over the reference
-/// positions of the nodes `movable` flags (one per node; the others stay), from tmpl.reference
-/// (its exact positions when empty), no move giving a child an edge ratio above
-/// max(max_edge_ratio, its start) (node_optimizer.hpp's sweeps and node_joint_ascent.hpp's
-/// joint ascent, in rounds until the minimum stops rising). Deterministic. Writes
-/// tmpl.reference (does not compile) and returns the minimum.
-double template_reference_optimize_nodes(HexTemplate& tmpl, const std::vector<uint8_t>& movable,
-                                         double max_edge_ratio);
-
 /// The edge-ratio cap of the offline optimisation: no child of a template gets an edge ratio
 /// above max(6, its ratio at the exact positions). 6 is the largest the thesis' positions give
 /// a standard template's child (1-13's corner children: an edge of 1 beside one of 1/6), so the
-/// reference positions never stretch a child more than the thesis' worst; placement's cap (20,
-/// PlacementOptions::max_edge_ratio) reaches the same minima on the standard templates, but
-/// through slivers (1-5's two interior nodes drawn together to an edge ratio of 16), which a
-/// distorted parent then inverts first.
+/// reference positions never stretch a child more than the thesis' worst; placement's looser
+/// cap (PlacementOptions::max_edge_ratio) reaches the same minima on the standard templates, but
+/// through slivers, which a distorted parent then inverts first (results/templates.md).
+/// The directional configurations follow the same principle: no child above max(the largest
+/// edge ratio the thesis' positions give a child of the corpus' configurations, its own there).
 inline constexpr double template_reference_edge_ratio = 6;
 
-/// The same principle for the directional configurations (template_reference_add_configurations):
-/// no child above max(the largest edge ratio the thesis' positions give a child of the corpus'
-/// configurations, its own there); 12 on the corpus (a sixth of a third beside a half: children
-/// of steps nested in thin cells).
-
-/// One standard template in the offline optimisation's report.
+/// One standard template in the table: its movable nodes' reference positions and, for the
+/// report, its unit-cube minima.
 struct TemplateReferenceEntry {
   TemplateTag tag = TemplateTag::untouched;
   /// Minimum scaled Jacobian of the children on the unit cube: at the exact (thesis') positions,
@@ -150,7 +116,7 @@ struct TemplateReferenceConfiguration {
 struct TemplateReferenceTable {
   ReferenceRules rules;
   /// The adjustment rule's objective at its optimum: the minimum of the L-shaped case
-  /// (template_reference_optimize).
+  /// (experiments/cli/template_optimize.hpp).
   double adjustment_case_min = 0;
   double max_edge_ratio = template_reference_edge_ratio;  ///< of the standard templates
   double configuration_edge_ratio = 0;                    ///< of the configurations
@@ -164,36 +130,87 @@ struct TemplateReferenceTable {
   double corpus_worst_min = 1;
 };
 
-/// The offline optimisation of the standard templates (see template_reference.cpp): the face
-/// rule (along, across) that maximises the smallest unit-cube minimum over the templates with
-/// 1-4 faces (1-13, 1-5, 1-4), each template's movable nodes at that rule, each template's own
-/// best rule (the bound), and the adjustment rule that maximises the minimum of the L-shaped
-/// case (the thesis' G-1 on a 4 x 4 x 4 brick) at the reference positions, its directional
-/// configurations optimised. Installs what it tries (template_reference_install) and leaves the
-/// result installed, without configurations (template_reference_add_configurations).
-TemplateReferenceTable template_reference_optimize(
-    double max_edge_ratio = template_reference_edge_ratio);
-
-/// Adds to `table` the directional configurations of `composites` (plan-owned templates of
-/// both refiners with composed reference positions, e.g. from the plans of a corpus of
-/// refinements): each distinct configuration once, its movable nodes optimised on the unit
-/// cube (template_reference_optimize_nodes, the cap table.configuration_edge_ratio: the largest
-/// edge ratio of a child of `composites` at the exact positions) and kept when that raises its
-/// minimum.
-/// `counts` (empty, or one per composite): how many hexes each stands for (1 when empty).
-void template_reference_add_configurations(TemplateReferenceTable& table,
-                                           std::span<const HexTemplate* const> composites,
-                                           std::span<const int64_t> counts = {});
-
-/// The table as the C++ source of template_reference_table.inc.
-std::string template_reference_table_source(const TemplateReferenceTable& table);
-
-/// The committed table (what the library reads), for reports and tests.
+/// The committed table (template_reference_table.inc): what the library reads.
 TemplateReferenceTable template_reference_committed();
 
-/// Makes `table` the one the library uses: the standard templates' reference positions
-/// (template_set_reference) and the directional configurations. For the offline optimisation
-/// only: not thread-safe, and no refinement may run meanwhile.
-void template_reference_install(const TemplateReferenceTable& table);
+/// Sets tmpl.reference from `table` for a standard template (by its tag; a template the table
+/// does not list keeps its exact positions, tmpl.reference empty; so does one whose positions
+/// all equal the exact ones). Throws OperationError when the table's row has no positions for
+/// a template with movable nodes. Does not compile.
+void template_reference_from_table(HexTemplate& tmpl, const TemplateReferenceTable& table);
+
+/// A template's configuration up to the 48 cube symmetries: two 64-bit hashes of its nodes'
+/// exact positions and its children in a canonical frame (the symmetry `symmetry` maps the
+/// template into it), and the order of the nodes there (order[k]: the node at canonical rank
+/// k, nodes sorted by their position in the canonical frame).
+struct TemplateConfiguration {
+  std::array<uint64_t, 2> hash{};
+  int8_t symmetry = 0;
+  std::vector<int32_t> order;
+};
+
+/// The configuration of a template in canonical orientation (its nodes' `ref`; it need not be
+/// compiled).
+TemplateConfiguration template_configuration(const HexTemplate& tmpl);
+
+/// The templates a refinement uses, at one table's reference positions: the standard templates
+/// compiled for the 48 symmetries, the split-mask tables over them, and the table's directional
+/// configurations. The library's own (template_library_committed) reads the committed table;
+/// template_library_build makes one of another table, which is how the template optimiser
+/// (experiments/cli/template_optimize.hpp) tries its candidates: a value passed to the
+/// refinement (refine()'s `templates`), never a table swapped under the library. Neither
+/// copyable nor movable: the mask tables point into `standard`.
+struct TemplateLibrary {
+  /// One directional configuration as the table file lists it: its movable nodes' positions
+  /// (canonical order) are configuration_positions[first .. first + count).
+  struct ConfigurationRow {
+    uint64_t hash0, hash1;
+    int32_t nodes, first, count;
+    double composed_min, reference_min;
+    int64_t seen;
+  };
+  /// 1-27, 1-13, 1-5, 1-4, 1-3, 1-3 with one and with two adjustments, 1-9 (template_standard_tags
+  /// order).
+  std::array<HexTemplate, 8> standard;
+  /// Per TemplateSet: the template and symmetry of each split-edge mask
+  /// (template_mask_table_fill).
+  std::array<TemplateMaskTable, 2> masks;
+  /// The table's directional configurations, ascending (hash0, hash1), and their positions: the
+  /// committed table's compiled-in arrays themselves (nothing to build before the first lookup),
+  /// or another table's, held in the storage below.
+  std::span<const ConfigurationRow> configuration_rows;
+  std::span<const std::array<double, 3>> configuration_positions;
+  std::vector<ConfigurationRow> configuration_row_storage;
+  std::vector<std::array<double, 3>> configuration_position_storage;
+
+  TemplateLibrary() = default;
+  TemplateLibrary(const TemplateLibrary&) = delete;
+  TemplateLibrary& operator=(const TemplateLibrary&) = delete;
+
+  /// The standard template tagged `tag`; OperationError for a tag with none.
+  const HexTemplate& of(TemplateTag tag) const;
+  /// The template and symmetry for a split-edge mask (template_for_mask, on this library).
+  TemplateChoice choice(uint16_t mask, TemplateSet set = TemplateSet::element_by_element) const {
+    return masks[static_cast<int>(set)][mask & 0xFFF];
+  }
+};
+
+/// The library of `table`: every standard template (template_standard_build), the mask tables of
+/// both sets, the table's configurations. Throws OperationError as template_reference_from_table.
+std::unique_ptr<const TemplateLibrary> template_library_build(const TemplateReferenceTable& table);
+
+/// The standard template tagged `tag` (template_standard_exact) with its reference positions
+/// from `table` (template_reference_from_table), compiled for the 48 symmetries.
+HexTemplate template_standard_build(TemplateTag tag, const TemplateReferenceTable& table);
+
+/// The library of the committed table, built once (thread-safe): what every refinement uses
+/// unless it is given another, and what template_1_27() ... template_for_mask() return from.
+const TemplateLibrary& template_library_committed();
+
+/// Sets the movable nodes' reference positions of a directional configuration (a plan-owned
+/// template whose tmpl.reference holds the composed positions) from the configurations of
+/// `templates`, if they list its configuration; returns whether it did. Does not compile.
+bool template_reference_from_configurations(
+    HexTemplate& tmpl, const TemplateLibrary& templates = template_library_committed());
 
 }  // namespace hexrefine

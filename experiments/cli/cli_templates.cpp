@@ -7,14 +7,12 @@
 /// reach where the shared face rule stops it, and the sets it belongs to; the directional
 /// configurations of the committed table. The JSON behind results/templates.md.
 ///
-/// --optimize OUT runs the offline optimisation (template_reference_optimize) and writes the
-/// table's C++ source to OUT (algorithms/templates/template_reference_table.inc is the committed
-/// one). The directional configurations are collected from the plans of a fixed corpus of generated
-/// refinements (selective_plan with the configuration table off: their composed positions),
-/// which are built from the library's compiled-in reference positions: when the optimisation's
-/// rule or templates differ from those, OUT gets the templates alone and the command says to
-/// rebuild and run it again (a second run, on the new library, adds the configurations; the
-/// optimisation is deterministic, so that is a fixed point).
+/// --optimize OUT runs the template optimiser (experiments/cli/template_optimize.hpp) and writes
+/// the table's C++ source to OUT (algorithms/templates/template_reference_table.inc is the
+/// committed one); the listing then shows the new table, through a library built from it. The
+/// directional configurations are collected from the plans of a fixed corpus of generated
+/// refinements (the configuration table off: their composed positions), planned with the
+/// optimised templates.
 
 #include <bit>
 #include <cstdio>
@@ -24,25 +22,16 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "algorithms/refiners/refiner.hpp"
 #include "algorithms/templates/template_reference.hpp"
 #include "experiments/cli/cli.hpp"
 #include "experiments/cli/cli_output.hpp"
+#include "experiments/cli/template_optimize.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/error.hpp"
-#include "mesh/generators.hpp"
-#include "mesh/selection.hpp"
-#include "mesh/topology.hpp"
 
 namespace hexrefine {
 
 namespace {
-
-constexpr std::array<const HexTemplate* (*)(), 8> standard = {
-    [] { return &template_1_27(); },        [] { return &template_1_13(); },
-    [] { return &template_1_5(); },         [] { return &template_1_4(); },
-    [] { return &template_1_3(); },         [] { return &template_1_3_adjust1(); },
-    [] { return &template_1_3_adjust2(); }, [] { return &template_1_9(); }};
 
 /// What stops a template where its reference positions leave it, in words.
 std::string template_constraint(const TemplateReferenceEntry& e) {
@@ -54,88 +43,6 @@ std::string template_constraint(const TemplateReferenceEntry& e) {
   return "its own: the parent's corners fixed";
 }
 
-/// The corpus of the directional configurations: generated meshes and seeded target sets,
-/// planned by both refiners (the same every run); one composite per configuration in `out`, how
-/// many hexes had it in `counts`.
-std::string corpus_collect(std::vector<std::unique_ptr<HexTemplate>>& out,
-                           std::vector<int64_t>& counts) {
-  std::map<std::array<uint64_t, 2>, size_t> index;
-  struct Case {
-    std::array<int, 3> dims;
-    double jitter;
-    std::vector<std::string> select;
-  };
-  std::vector<Case> cases;
-  auto random = [](double fraction, int seed) {
-    char spec[64];
-    std::snprintf(spec, sizeof spec, "random:%g,%d", fraction, seed);
-    return std::string(spec);
-  };
-  // Many small bricks: the configurations are local, and rare ones are met by sampling often.
-  for (int n : {5, 6, 8})
-    for (double fraction : {0.05, 0.1, 0.15, 0.2, 0.3})
-      for (int seed = 100; seed < (n == 8 ? 140 : 200); ++seed)
-        cases.push_back({{n, n, n}, 0, {random(fraction, seed)}});
-  // Seeds 1-6 only: the study's cases (seed 7) stay out of the corpus.
-  for (int n : {6, 10, 16})
-    for (double fraction : {0.01, 0.02, 0.03, 0.05, 0.08, 0.12, 0.2})
-      for (int seed = 1; seed <= (n <= 10 ? 6 : 2); ++seed)
-        cases.push_back({{n, n, n}, 0, {random(fraction, seed)}});
-  for (double fraction : {0.01, 0.02, 0.03, 0.05, 0.08, 0.12, 0.2})
-    for (int seed = 1; seed <= 6; ++seed)
-      cases.push_back({{27, 27, 27}, 0, {random(fraction, seed)}});
-  for (double fraction : {0.03, 0.05})
-    for (int seed = 1; seed <= 2; ++seed)
-      cases.push_back({{40, 40, 40}, 0, {random(fraction, seed)}});
-  for (int seed = 1; seed <= 6; ++seed)
-    cases.push_back({{16, 16, 16}, 0, {"blob:200," + std::to_string(seed)}});
-  cases.push_back({{10, 10, 10}, 0, {"boundary:-1,0,0", "boundary:0,0,-1"}});
-  for (int n : {10, 20}) {
-    const double c = n / 2.0, r = 0.3 * n;
-    cases.push_back({{n, n, n},
-                     0,
-                     {"sphere:" + std::to_string(c) + "," + std::to_string(c) + "," +
-                      std::to_string(c) + "," + std::to_string(r)}});
-  }
-  RefineOptions options;
-  options.placement.configuration_table = false;
-  int64_t planned = 0;
-  for (const Case& c : cases) {
-    BrickParams p;
-    p.dims = c.dims;
-    p.size = {double(c.dims[0]), double(c.dims[1]), double(c.dims[2])};
-    p.jitter = c.jitter;
-    const HexMesh mesh = generate_brick(p);
-    const HexTopology topology = topology_build(mesh);
-    const std::vector<int32_t> targets = select_hexes(mesh, topology, c.select).hexes;
-    if (targets.empty()) continue;
-    for (const char* method : {"selective", "sheet"}) {
-      RefineStats stats;
-      RefinementPlan plan;
-      try {
-        plan = refine_method(method).plan(mesh, topology, targets, options, stats);
-      } catch (const OperationError&) {
-        continue;
-      }
-      ++planned;
-      for (auto& t : plan.owned) {
-        if (t->tag != TemplateTag::directional && t->tag != TemplateTag::sheet) continue;
-        const auto [it, inserted] = index.try_emplace(template_configuration(*t).hash, out.size());
-        if (inserted) {
-          out.push_back(std::move(t));
-          counts.push_back(0);
-        }
-        ++counts[it->second];
-      }
-    }
-  }
-  return std::to_string(planned) +
-         " plans (Selective Approach and sheet refinement) on generated bricks: 5^3, 6^3, 8^3 "
-         "with random targets 5-30 % (seeds 100-199, 8^3 100-139); 6^3, 10^3, 16^3, 27^3 with "
-         "1-20 %, 40^3 with 3 and 5 % (seeds 1-6); 16^3 blobs, the L-shaped case, spheres at "
-         "10^3 and 20^3 (experiments/cli_templates.cpp)";
-}
-
 int templates_run(const CliArgs& a) {
   if (!a.positional.empty())
     throw InputError("hexrefine templates: unexpected argument '" + a.positional[0] + "'");
@@ -144,28 +51,21 @@ int templates_run(const CliArgs& a) {
   const std::optional<std::string> optimize = a.value("--optimize");
   if (optimize) cli_output_check("hexrefine templates", *optimize, CliOutputKind::report);
 
-  // What the library uses: the committed table, or the one computed here (installed).
+  // What the listing shows: the committed table and its library, or the table computed here
+  // and a library of it.
   TemplateReferenceTable used = template_reference_committed();
+  std::unique_ptr<const TemplateLibrary> optimised;
   if (optimize) {
-    // Installs the new rules and templates: the corpus is planned with them.
-    TemplateReferenceTable table = template_reference_optimize(template_reference_edge_ratio);
-    std::vector<std::unique_ptr<HexTemplate>> composites;
-    std::vector<int64_t> counts;
-    table.corpus = corpus_collect(composites, counts);
-    std::vector<const HexTemplate*> pointers;
-    for (const auto& t : composites) pointers.push_back(t.get());
-    table.configurations.clear();
-    table.corpus_hexes = table.corpus_configurations = 0;
-    table.corpus_worst_min = 1;
-    template_reference_add_configurations(table, pointers, counts);
-    template_reference_install(table);
+    TemplateReferenceTable table = template_table_optimize();
     std::cout << "directional configurations: " << table.corpus_configurations << " distinct in "
               << table.corpus_hexes << " directional hexes, " << table.configurations.size()
               << " raised by the optimisation kept\n";
     file_write_atomically(*optimize,
                           [&](std::ostream& os) { os << template_reference_table_source(table); });
+    optimised = template_library_build(table);
     used = std::move(table);
   }
+  const TemplateLibrary& library = optimised ? *optimised : template_library_committed();
 
   nlohmann::json list = nlohmann::json::array();
   std::cout << "face rule (1-4 face transition nodes, u along the split edge, v across): ("
@@ -178,14 +78,14 @@ int templates_run(const CliArgs& a) {
             << "nodes" << std::setw(10) << "children" << std::setw(11) << "trilinear"
             << std::setw(11) << "reference" << std::setw(9) << "bound"
             << "constraint; sets\n";
-  for (const auto& get : standard) {
-    const HexTemplate* t = get();
+  for (const HexTemplate& standard : library.standard) {
+    const HexTemplate* t = &standard;
     const uint16_t mask = template_split_edges(*t);
     std::vector<std::string> sets;
     for (const auto& [set, name] :
          {std::pair{TemplateSet::element_by_element, "element_by_element"},
           std::pair{TemplateSet::sheet_directional, "sheet_directional"}})
-      if (template_for_mask(mask, set).tmpl == t) sets.push_back(name);
+      if (library.choice(mask, set).tmpl == t) sets.push_back(name);
     const double trilinear = template_validate(*t);
     const double reference = template_validate(*t, TemplatePositions::reference);
     TemplateReferenceEntry entry;

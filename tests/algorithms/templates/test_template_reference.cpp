@@ -2,16 +2,15 @@
 /// Reference positions (algorithms/templates/template_reference.hpp): the committed table's values
 /// on the unit cube, the face rule every template with a 1-4 face follows, the conformity argument
 /// (the reference position of a node on an edge or face does not depend on which hex around it
-/// places it) on refinement plans of bricks and a real mesh, the canonical form of the
-/// directional configurations, and the table file being exactly what the generator writes.
+/// places it) on refinement plans of bricks and a real mesh, and the canonical form of the
+/// directional configurations. The optimiser that writes the table is tested with it
+/// (tests/experiments/cli/test_template_optimize.cpp).
 
 #include "algorithms/templates/template_reference.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <unordered_map>
 
 #include "algorithms/refiners/refiner.hpp"
@@ -195,8 +194,8 @@ TEST(TemplateReference, EveryHexAroundAnEdgeOrFaceNodePutsItInTheSamePlace) {
       const HexTopology topology = topology_build(c.mesh);
       const std::vector<int32_t> targets = select_hexes(c.mesh, topology, {c.select}).hexes;
       RefineStats stats;
-      const RefinementPlan plan =
-          refine_method(method).plan(c.mesh, topology, targets, RefineOptions{}, stats);
+      const RefinementPlan plan = refine_method(method).plan(
+          c.mesh, topology, targets, RefineOptions{}, stats, template_library_committed());
       const auto [worst, count] = plan_reference_disagreement(c.mesh, topology, plan);
       const auto [lo, hi] = mesh_bounding_box(c.mesh);
       EXPECT_LT(worst, 1e-12 * (hi - lo).norm());
@@ -218,7 +217,7 @@ TEST(TemplateReference, AConfigurationIsFoundInEveryOrientation) {
   const RefinementPlan plan =
       refine_method("selective")
           .plan(m, t, select_hexes(m, t, {"boundary:-1,0,0", "boundary:0,0,-1"}).hexes,
-                RefineOptions{}, stats);
+                RefineOptions{}, stats, template_library_committed());
   int found = 0;
   for (const auto& owned : plan.owned) {
     const HexTemplate& composite = *owned;
@@ -256,36 +255,6 @@ TEST(TemplateReference, AConfigurationIsFoundInEveryOrientation) {
     }
   }
   EXPECT_GT(found, 0);
-}
-
-TEST(TemplateReference, OptimisingNodesNeverLowersTheMinimum) {
-  // 1-5 at the table's rules, its two interior nodes from the thesis' positions: the minimum
-  // rises from what the rule leaves (0.19) to the rule's bound, under the cap.
-  HexTemplate t = template_1_5();
-  t.reference.clear();
-  template_reference_set(t, template_reference_rules(), {});
-  const double start = template_validate(t, TemplatePositions::reference);
-  std::vector<uint8_t> movable(t.nodes.size());
-  for (size_t i = 0; i < t.nodes.size(); ++i) movable[i] = template_node_movable(t, i);
-  EXPECT_EQ(std::count(movable.begin(), movable.end(), 1), 2);
-  const double after = template_reference_optimize_nodes(t, movable, template_reference_edge_ratio);
-  EXPECT_GT(after, start + 0.1);
-  EXPECT_NEAR(after, 1 / std::sqrt(3.0), 2e-3);
-  for (size_t i = 0; i < t.nodes.size(); ++i)
-    if (!movable[i]) {
-      EXPECT_EQ(t.reference[i], template_node_reference(template_1_5(), i));
-    }
-}
-
-TEST(TemplateReference, TheCommittedTableIsWhatTheGeneratorWrites) {
-  // algorithms/templates/template_reference_table.inc is `hexrefine templates --optimize`'s output,
-  // not edited by hand: written again from what the library read, it is the same text.
-  std::ifstream in(std::string(HEXREFINE_SOURCE_DIR) +
-                   "/algorithms/templates/template_reference_table.inc");
-  ASSERT_TRUE(in);
-  std::stringstream text;
-  text << in.rdbuf();
-  EXPECT_EQ(template_reference_table_source(template_reference_committed()), text.str());
 }
 
 }  // namespace

@@ -168,6 +168,31 @@ std::string json_without_nan(const std::string& text) {
   return out;
 }
 
+}  // namespace
+
+json bench_json_file_read(const std::string& path, bool nan_allowed) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open");
+  std::stringstream content;
+  content << in.rdbuf();
+  try {
+    return json::parse(nan_allowed ? json_without_nan(content.str()) : content.str());
+  } catch (const json::exception& e) {
+    throw InputError(path + ": not valid JSON: " + e.what());
+  }
+}
+
+std::string digits_grouped(long long n) {
+  std::string digits = std::to_string(n), out;
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+namespace {
+
 double time_unit_seconds(const std::string& unit, const std::string& file,
                          const std::string& name) {
   if (unit == "ns") return 1e-9;
@@ -186,16 +211,7 @@ double median_of(std::vector<double> values) {
 /// Reads a Google Benchmark JSON file into name -> times (see the file comment for the rules).
 /// InputError naming the file (and the benchmark) for anything unreadable.
 std::map<std::string, BenchTimes> bench_read(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open");
-  std::stringstream content;
-  content << in.rdbuf();
-  json doc;
-  try {
-    doc = json::parse(json_without_nan(content.str()));
-  } catch (const json::exception& e) {
-    throw InputError(path + ": not valid JSON: " + e.what());
-  }
+  const json doc = bench_json_file_read(path, true);
   if (!doc.is_object() || !doc.contains("benchmarks") || !doc["benchmarks"].is_array())
     throw InputError(path + ": not a Google Benchmark JSON file (no \"benchmarks\" array)");
 

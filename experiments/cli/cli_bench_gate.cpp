@@ -52,16 +52,7 @@ struct CountFile {
 /// Reads and validates a file of `hexrefine bench --instructions`. InputError naming the file
 /// and the key (and the entry) for anything that is not one.
 CountFile count_file_read(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open");
-  std::stringstream content;
-  content << in.rdbuf();
-  json doc;
-  try {
-    doc = json::parse(content.str());
-  } catch (const json::exception& e) {
-    throw InputError(path + ": not valid JSON: " + e.what());
-  }
+  const json doc = bench_json_file_read(path, false);
   if (!doc.is_object())
     throw InputError(path +
                      ": expected a JSON object (an output of hexrefine bench --instructions)");
@@ -105,15 +96,6 @@ CountFile count_file_read(const std::string& path) {
     file.order.push_back(name);
   }
   return file;
-}
-
-std::string thousands(long long n) {
-  std::string digits = std::to_string(n), out;
-  for (size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
-    out += digits[i];
-  }
-  return out;
 }
 
 std::string percent_text(double ratio) {
@@ -199,9 +181,9 @@ int bench_gate_run(const CliArgs& a) {
       improvements.emplace_back(name, ratio);
     }
     std::cout << std::left << std::setw(static_cast<int>(width)) << name << std::right
-              << std::setw(16) << thousands(b.instructions) << std::setw(16)
-              << thousands(n.instructions) << std::setw(9) << ratio_text(ratio) << "  " << verdict
-              << "\n";
+              << std::setw(16) << digits_grouped(b.instructions) << std::setw(16)
+              << digits_grouped(n.instructions) << std::setw(9) << ratio_text(ratio) << "  "
+              << verdict << "\n";
     const std::string changes = work_changes(b, n);
     if (!changes.empty()) std::cout << "    work changed: " << changes << "\n";
   }

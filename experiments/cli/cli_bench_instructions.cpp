@@ -194,15 +194,6 @@ std::string first_line_of(const std::string& command) {
   return status != 0 || line.empty() ? "unknown" : line;
 }
 
-std::string thousands(long long n) {
-  std::string digits = std::to_string(n), out;
-  for (size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
-    out += digits[i];
-  }
-  return out;
-}
-
 /// One workload's run: its process, files and start time.
 struct Running {
   size_t index;
@@ -366,7 +357,7 @@ int bench_instructions_run(const CliArgs& a) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - r.start).count();
     std::cerr << "hexrefine bench: [" << done << "/" << names.size() << "] " << names[r.index]
-              << ": " << thousands(instructions) << " instructions (" << std::fixed
+              << ": " << digits_grouped(instructions) << " instructions (" << std::fixed
               << std::setprecision(1) << seconds << " s under Callgrind)\n";
   }
   const double wall =

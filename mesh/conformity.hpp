@@ -96,8 +96,10 @@
 /// their corners, four hexes per evaluation where the machine has AVX2: mesh_hex_measures),
 /// faces matched by hex_face_adjacency_build (a counting sort of the face slots by lowest node;
 /// no general topology), duplicate nodes by a counting sort of the points into cells compared on
-/// float keys, boundary edges counted by a radix sort of their keys, and hash grids over the
-/// boundary faces for the geometric tests. Memory at its peak: about 32 bytes per hex beyond the
+/// float keys, boundary edges counted by a radix sort of their keys, hash grids over the
+/// boundary faces for the geometric tests, and bodies by a union-find over the nodes (one serial
+/// pass over the hexes, 4 bytes per node; labels only when there are several bodies). Memory at
+/// its peak: about 32 bytes per hex beyond the
 /// mesh itself (the face slots and the per-thread bucket counts; doublets are found while
 /// matching, without a neighbour array). Every figure of the report is the same for any thread
 /// count (sums per fixed chunk, combined in chunk order).

@@ -61,7 +61,7 @@ TEST(CliCheckContact, SelfContactIsANoteAndASplitCornerIsAGapInOneBody) {
   EXPECT_EQ(c.exit_code, 1) << c.output;
   EXPECT_NE(c.output.find("2 non-conformal faces"), std::string::npos) << c.output;
   EXPECT_NE(c.output.find("1 duplicate nodes"), std::string::npos) << c.output;
-  EXPECT_EQ(c.output.find("bodies"), std::string::npos) << c.output;
+  EXPECT_EQ(c.output.find(" bodies, "), std::string::npos) << c.output;
 }
 
 TEST(CliCheckContact, BodiesInContactAreNamedAndValid) {
@@ -88,7 +88,7 @@ TEST(CliCheckContact, BodiesInContactAreNamedAndValid) {
   // A mesh of one body names no bodies.
   const CliRun one = cli_run("check " + shared_mesh("sphere_conforming.mesh"));
   EXPECT_EQ(one.exit_code, 0) << one.output;
-  EXPECT_EQ(one.output.find("bodies"), std::string::npos) << one.output;
+  EXPECT_EQ(one.output.find(" bodies, "), std::string::npos) << one.output;
 }
 
 }  // namespace

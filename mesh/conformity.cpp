@@ -491,7 +491,10 @@ MeshBodies mesh_bodies(const HexMesh& mesh, const std::vector<char>& used) {
   for (const HexCell& c : mesh.hexes) {
     int32_t r = find(c[0]);
     for (int k = 1; k < 8; ++k) {
-      const int32_t other = find(c[k]);
+      // Most nodes already point at their root (written below when last seen): one load.
+      const int32_t parent = root[c[k]];
+      if (parent == r) continue;
+      const int32_t other = find(parent);
       // The lower root wins: every link points to a lower node, and a body's root is its
       // lowest node (the labelling below relies on both).
       if (other < r) {
@@ -500,6 +503,7 @@ MeshBodies mesh_bodies(const HexMesh& mesh, const std::vector<char>& used) {
       } else if (other > r) {
         root[other] = r;
       }
+      root[c[k]] = r;
     }
   }
   MeshBodies out;

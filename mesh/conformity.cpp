@@ -93,6 +93,9 @@ struct FaceContact {
 /// and self-contact, both ascending (see conformity.hpp).
 struct BoundaryContacts {
   std::vector<int32_t> gap_faces, self_contact_faces;
+  /// Coincident face pairs between bodies (a connected contact whose faces lie in different
+  /// bodies), each pair counted once whichever face found the other.
+  int64_t interface_face_pairs = 0;
 };
 
 /// The contact of boundary face i with boundary face j of `surface`, if they touch (FaceContact).
@@ -139,9 +142,13 @@ std::optional<FaceContact> boundary_faces_touch(const HexMesh& mesh, const Bound
 /// Without a reference: the boundary faces that touch another part of the boundary, found from
 /// each face's first corner (the grid lists the faces within the tight tolerance of it), and
 /// grouped into contact patches (faces linked by a contact): a patch with a connected contact is
-/// a gap, the others self-contact.
-BoundaryContacts boundary_contacts(const HexMesh& mesh, const BoundarySurface& surface,
-                                   int threads) {
+/// a gap, the others self-contact. `node_body_label`: empty for a mesh of one body, else the body
+/// of every node (MeshBodies); a connected contact (a corner of one face at a corner of the
+/// other: coincident unmerged nodes) between faces of two bodies is then an interface, counted
+/// and left out of the patches, so it makes no gap. A contact between two bodies with no corner
+/// on a corner stays self-contact, as in one body.
+BoundaryContacts boundary_contacts(const HexMesh& mesh, const BoundarySurface& surface, int threads,
+                                   const std::vector<int32_t>& node_body_label) {
   const int64_t faces = static_cast<int64_t>(surface.quads.size());
   std::vector<double> tight(surface.quads.size());
   for (int64_t i = 0; i < faces; ++i)
@@ -165,6 +172,26 @@ BoundaryContacts boundary_contacts(const HexMesh& mesh, const BoundarySurface& s
       });
     }
   });
+  BoundaryContacts out;
+  if (!node_body_label.empty()) {
+    // Faces of two bodies share no node, so a connected contact between them is a corner on a
+    // corner: the unmerged nodes of a glued interface, matching (face on face) or not (a small
+    // face on a big one, as where bodies meshed apart are glued). Pairs as (lower, higher) face,
+    // so a pair found from both sides counts once.
+    auto face_body = [&](int32_t face) {
+      return node_body_label[mesh.hexes[surface.slots[face].hex][0]];
+    };
+    std::vector<uint64_t> pairs;
+    for (std::vector<FaceContact>& list : found)
+      std::erase_if(list, [&](const FaceContact& c) {
+        if (!c.connected || face_body(c.face) == face_body(c.other)) return false;
+        pairs.push_back(static_cast<uint64_t>(std::min(c.face, c.other)) << 32 |
+                        static_cast<uint32_t>(std::max(c.face, c.other)));
+        return true;
+      });
+    std::sort(pairs.begin(), pairs.end());
+    out.interface_face_pairs = std::unique(pairs.begin(), pairs.end()) - pairs.begin();
+  }
   // Contact patches: union-find over the faces in a contact (few: none in most meshes).
   std::vector<int32_t> members;
   for (const std::vector<FaceContact>& list : found)
@@ -193,7 +220,6 @@ BoundaryContacts boundary_contacts(const HexMesh& mesh, const BoundarySurface& s
   for (const std::vector<FaceContact>& list : found)
     for (const FaceContact& c : list)
       if (c.connected) gap[root(index_of(c.face))] = 1;
-  BoundaryContacts out;
   for (size_t k = 0; k < members.size(); ++k)
     (gap[root(static_cast<int32_t>(k))] ? out.gap_faces : out.self_contact_faces)
         .push_back(members[k]);
@@ -260,6 +286,12 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box_on_threads(const H
   return {lo, hi};
 }
 
+/// Nodes close to a lower-id node (count_duplicate_nodes): within one body (duplicates, a defect
+/// where it splits a face) and between bodies (an interface, none for a mesh of one body).
+struct DuplicateNodes {
+  int64_t duplicate_nodes = 0, interface_nodes = 0;
+};
+
 /// Nodes within mesh_check_duplicate_tolerance x diagonal of a lower-id node. Points are
 /// bucketed by a coarse cell (about four points per cell, one counting sort); near pairs share a
 /// cell unless they straddle a cell wall, so only points within the tolerance of a wall also
@@ -268,9 +300,13 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounding_box_on_threads(const H
 /// (below). A crowded cell (a refined region is far denser than the box's mean) is sorted by key
 /// and swept, comparing only pairs within the key tolerance: k log k for k points, quadratic only
 /// if their keys fall within it.
-int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
+/// `node_body_label`: empty for a mesh of one body, else the body of every node (MeshBodies, -1
+/// for an unused node). Then a node close to a lower-id node of another body (both used) is an
+/// interface node instead, unless it is also close to a lower-id node of its own body.
+DuplicateNodes count_duplicate_nodes(const HexMesh& mesh, int threads,
+                                     const std::vector<int32_t>& node_body_label) {
   const int32_t n = mesh.point_count();
-  if (n < 2) return 0;
+  if (n < 2) return {};
   // Named copies, not a structured binding: clang 14 (the fuzz build) cannot capture a binding.
   const auto box = mesh_bounding_box_on_threads(mesh, threads);
   const Eigen::Vector3d lo = box.first, hi = box.second;
@@ -371,13 +407,21 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
   auto cell_begin = [&](int64_t c) { return c == 0 ? uint32_t{0} : cell_end[c - 1]; };
 
   // Pairs are compared per chunk of cells, then per chunk of points near a wall, on every thread;
-  // a close pair marks its higher node (atomically: two chunks may mark the same node).
+  // a close pair marks its higher node (atomically: two chunks may mark the same node): bit 1
+  // within one body, bit 2 between two.
   std::vector<char> duplicate(n, 0);
+  const bool one_body = node_body_label.empty();
   auto compare = [&](const KeyedPoint& a, const KeyedPoint& b) {
     if (a.point != b.point && std::abs(double{a.key} - double{b.key}) <= key_tolerance &&
-        (mesh.points[a.point] - mesh.points[b.point]).norm() <= tolerance)
+        (mesh.points[a.point] - mesh.points[b.point]).norm() <= tolerance) {
+      char mark = 1;
+      if (!one_body) {
+        const int32_t body_a = node_body_label[a.point], body_b = node_body_label[b.point];
+        if (body_a >= 0 && body_b >= 0 && body_a != body_b) mark = 2;
+      }
       std::atomic_ref<char>(duplicate[std::max(a.point, b.point)])
-          .store(1, std::memory_order_relaxed);
+          .fetch_or(mark, std::memory_order_relaxed);
+    }
   };
   // A crowded cell (a refined region is far denser than the bounding box's mean) is sorted by key
   // and swept: only pairs within the key tolerance are compared, so it costs k log k, not k^2.
@@ -416,7 +460,66 @@ int64_t count_duplicate_nodes(const HexMesh& mesh, int threads) {
                           }
                     }
                   });
-  return std::count(duplicate.begin(), duplicate.end(), 1);
+  DuplicateNodes out;
+  for (const char mark : duplicate) {
+    out.duplicate_nodes += mark & 1;
+    out.interface_nodes += mark == 2;
+  }
+  return out;
+}
+
+/// Bodies: the connected components of the hexes under "shares a node". `node_body_label` is
+/// empty when there is one body (or none), else it holds the body of every node, numbered
+/// 0..bodies-1 in the order of their lowest node, and -1 for an unused node (`used`: n flags, 1
+/// where a hex uses the node).
+struct MeshBodies {
+  int64_t bodies = 0;
+  std::vector<int32_t> node_body_label;
+};
+
+/// MeshBodies of `mesh` by a union-find over its nodes (each hex links its eight; path halving,
+/// the lower root kept): linear in practice, one int32 per node and no per-hex storage, so a mesh
+/// of one body pays one pass over its hexes.
+MeshBodies mesh_bodies(const HexMesh& mesh, const std::vector<char>& used) {
+  const int32_t n = mesh.point_count();
+  std::vector<int32_t> root(static_cast<size_t>(n));
+  std::iota(root.begin(), root.end(), 0);
+  auto find = [&](int32_t v) {
+    while (root[v] != v) v = root[v] = root[root[v]];
+    return v;
+  };
+  for (const HexCell& c : mesh.hexes) {
+    int32_t r = find(c[0]);
+    for (int k = 1; k < 8; ++k) {
+      // Most nodes already point at their root (written below when last seen): one load.
+      const int32_t parent = root[c[k]];
+      if (parent == r) continue;
+      const int32_t other = find(parent);
+      // The lower root wins: every link points to a lower node, and a body's root is its
+      // lowest node (the labelling below relies on both).
+      if (other < r) {
+        root[r] = other;
+        r = other;
+      } else if (other > r) {
+        root[other] = r;
+      }
+      root[c[k]] = r;
+    }
+  }
+  MeshBodies out;
+  for (int32_t v = 0; v < n; ++v) out.bodies += used[v] && root[v] == v;
+  if (out.bodies <= 1) return out;
+  // In node order a node's parent (lower) is already labelled with its body, and a root is
+  // the first node of its body: one pass turns the links into labels.
+  int32_t next = 0;
+  for (int32_t v = 0; v < n; ++v) {
+    if (root[v] == v)
+      root[v] = used[v] ? next++ : -1;
+    else
+      root[v] = root[root[v]];
+  }
+  out.node_body_label = std::move(root);
+  return out;
 }
 
 /// The message mesh_validate_ids gives for the lowest of hexes [begin, end) whose node ids are
@@ -525,9 +628,14 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
                        " values for " + std::to_string(mesh.hexes.size()) + " hexes");
   if (reference) mesh_validate_ids(*reference, "reference mesh", threads);
   r.unused_nodes = std::count(used.begin(), used.end(), 0);
+  // Bodies first: coincident nodes and faces between two bodies are interfaces, not defects.
+  const MeshBodies bodies = mesh_bodies(mesh, used);
+  r.bodies = bodies.bodies;
   used = {};
 
-  r.duplicate_nodes = count_duplicate_nodes(mesh, threads);
+  const DuplicateNodes duplicates = count_duplicate_nodes(mesh, threads, bodies.node_body_label);
+  r.duplicate_nodes = duplicates.duplicate_nodes;
+  r.interface_nodes = duplicates.interface_nodes;
   // Doublets come from the matching itself: no neighbour array (24 bytes per hex) is built.
   HexFaceAdjacency adjacency = hex_face_adjacency_build(mesh, threads, false);
   r.nonmanifold_faces = static_cast<int64_t>(adjacency.nonmanifold_faces.size());
@@ -613,9 +721,11 @@ MeshCheckReport mesh_check(const HexMesh& mesh, const HexMesh* reference, int th
                            (r.volume_relative_error <= mesh_check_geometry_tolerance &&
                             r.boundary_area_relative_error <= mesh_check_geometry_tolerance);
   } else {
-    const BoundaryContacts contacts = boundary_contacts(mesh, surface, threads);
+    const BoundaryContacts contacts =
+        boundary_contacts(mesh, surface, threads, bodies.node_body_label);
     non_conformal = contacts.gap_faces;
     r.self_contact_faces = static_cast<int64_t>(contacts.self_contact_faces.size());
+    r.interface_faces = contacts.interface_face_pairs;
   }
   r.non_conformal_faces = static_cast<int64_t>(non_conformal.size());
   for (int32_t i : non_conformal) defects.push_back(surface.slots[i].hex);
@@ -674,6 +784,9 @@ void to_json(nlohmann::json& j, const MeshCheckReport& r) {
   j["unused_nodes"] = r.unused_nodes;
   j["boundary_faces"] = r.boundary_faces;
   j["self_contact_faces"] = r.self_contact_faces;
+  j["bodies"] = r.bodies;
+  j["interface_faces"] = r.interface_faces;
+  j["interface_nodes"] = r.interface_nodes;
   j["min_scaled_jacobian"] = r.min_scaled_jacobian;
   j["mean_scaled_jacobian"] = r.mean_scaled_jacobian;
   j["max_edge_ratio"] = r.max_edge_ratio;

@@ -67,7 +67,18 @@
 ///   boundary faces (the boundary surface is not a closed 2-manifold there).
 /// - doublet: a pair of distinct hexes sharing two or more faces (counted once per pair).
 /// - inverted hex: hex_scaled_jacobian <= 0 (inverted or degenerate).
-/// - duplicate node: a node within 1e-12 x (bounding-box diagonal) of a node with a lower id.
+/// - body: a connected component of the hexes under "shares a node" (a union-find over the
+///   nodes, one pass over the hexes). A mesh of several bodies (parts glued or in contact along
+///   coincident faces with unmerged nodes, as Sierra, Peridigm and MFEM contact meshes are) is
+///   valid: a touching pair of faces joined by a corner on a corner (the unmerged nodes of a
+///   glued interface, matching or not), or a coincident pair of nodes, whose two sides lie in
+///   different bodies is an interface (interface_faces, interface_nodes), never a defect, and its
+///   faces are no gap (nor their nodes hanging). A touching pair of two bodies with no corner on
+///   a corner stays self-contact (a contact, not a glue). Within one body they stay what they
+///   were (a crack's split faces and nodes: its cracked hex still shares the nodes of its other
+///   faces with its neighbours, so it stays in the body).
+/// - duplicate node: a node within 1e-12 x (bounding-box diagonal) of a node with a lower id of
+///   the same body (see body).
 /// - unused node: a node no hex refers to.
 /// - self-contact face: see "Without a reference" above (not examined with a reference, whose
 ///   boundary the output's is compared with instead).
@@ -85,8 +96,10 @@
 /// their corners, four hexes per evaluation where the machine has AVX2: mesh_hex_measures),
 /// faces matched by hex_face_adjacency_build (a counting sort of the face slots by lowest node;
 /// no general topology), duplicate nodes by a counting sort of the points into cells compared on
-/// float keys, boundary edges counted by a radix sort of their keys, and hash grids over the
-/// boundary faces for the geometric tests. Memory at its peak: about 32 bytes per hex beyond the
+/// float keys, boundary edges counted by a radix sort of their keys, hash grids over the
+/// boundary faces for the geometric tests, and bodies by a union-find over the nodes (one serial
+/// pass over the hexes, 4 bytes per node; labels only when there are several bodies). Memory at
+/// its peak: about 32 bytes per hex beyond the
 /// mesh itself (the face slots and the per-thread bucket counts; doublets are found while
 /// matching, without a neighbour array). Every figure of the report is the same for any thread
 /// count (sums per fixed chunk, combined in chunk order).
@@ -129,6 +142,21 @@ struct MeshCheckReport {
   /// Boundary faces touching another part of the boundary with no node between them (without a
   /// reference only; not a defect).
   int64_t self_contact_faces = 0;
+  /// Connected components of the hexes under "shares a node" (0 for an empty mesh). Parts that
+  /// touch along coincident faces with unmerged nodes (glued or contact interfaces) are several
+  /// bodies: a valid mesh, whose interfaces are counted below and are no defect.
+  int64_t bodies = 0;
+  /// Pairs of boundary faces of two different bodies that touch (every corner of one lies on the
+  /// other) with a corner of one at a corner of the other: the coincident faces of a glued
+  /// interface, matching face on face or not (a small face on a big one), each pair counted
+  /// once; without a reference only (with one, the interface is on the reference's boundary and
+  /// is compared there). Such a pair within one body is a gap (non_conformal_faces); a touching
+  /// pair of two bodies with no corner on a corner is self-contact.
+  int64_t interface_faces = 0;
+  /// Nodes within the duplicate tolerance of a lower-id node of another body (both used by hexes)
+  /// and of no lower-id node of their own body: for two bodies, the coincident node pairs between
+  /// them. Such nodes within one body count as duplicate_nodes instead.
+  int64_t interface_nodes = 0;
   /// Over all hexes; 1 for an empty mesh.
   double min_scaled_jacobian = 1.0, mean_scaled_jacobian = 1.0;
   /// Largest hex_edge_ratio over all hexes (longest over shortest edge; 1 for an empty mesh):

@@ -17,8 +17,8 @@
 
 #include "algorithms/pipeline/pipeline.hpp"
 #include "algorithms/templates/template_library.hpp"
-#include "experiments/cli/cli.hpp"
 #include "experiments/bench/process_huge_pages.hpp"
+#include "experiments/cli/cli.hpp"
 #include "mesh/atomic_file.hpp"
 #include "mesh/conformity.hpp"
 #include "mesh/dual.hpp"
@@ -152,6 +152,11 @@ int check_run(const CliArgs& a) {
       out << ", from input hex " << (*parent)[w.hex];
     out << "\n";
   }
+  // Several bodies are a valid mesh (glued or contact parts): named, never listed as defects.
+  if (report.bodies > 1)
+    out << "  " << report.bodies << " bodies, " << report.interface_faces
+        << " interface face pairs, " << report.interface_nodes
+        << " interface nodes (coincident between bodies, unmerged: not a defect)\n";
   if (report.duplicate_nodes > 0)
     out << "  note: " << report.duplicate_nodes << " duplicate nodes\n";
   if (report.unused_nodes > 0) out << "  note: " << report.unused_nodes << " unused nodes\n";

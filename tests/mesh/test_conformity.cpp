@@ -203,7 +203,11 @@ TEST(Conformity, GapThroughAOneHexPlateIsNonConformalThoughItsCornersAreOnTheSur
   const MeshCheckReport r = mesh_check(m, &plate);
   EXPECT_EQ(r.non_conformal_faces, 2);
   EXPECT_FALSE(r.conformal);
-  EXPECT_EQ(r.duplicate_nodes, 4);
+  // The two hexes share no node: two bodies, so their four coincident node pairs are interface
+  // nodes; against the one-body reference their faces at x = 1 are off its boundary all the same.
+  EXPECT_EQ(r.bodies, 2);
+  EXPECT_EQ(r.interface_nodes, 4);
+  EXPECT_EQ(r.duplicate_nodes, 0);
 }
 
 TEST(Conformity, NonPlanarReferenceOnlyReportsGeometryErrors) {
@@ -335,17 +339,34 @@ TEST(Conformity, DuplicateNodesStraddlingASearchCellWall) {
 }
 
 TEST(Conformity, CrackOfDuplicatedNodesLeavesCoincidentFaces) {
-  HexMesh m = fixture_brick(2, 1, 1);
-  // Hex 1 gets its own copies of the four nodes on x = 1.
-  for (int v : {0, 3, 4, 7}) {
-    m.points.push_back(m.points[m.hexes[1][v]]);
-    m.hexes[1][v] = m.point_count() - 1;
+  HexMesh m = fixture_brick(2, 2, 1);
+  // Hex 0 gets its own copies of its four nodes on x = 1. It still shares its nodes at x = 0,
+  // y = 1 with hex 2, so the mesh stays one body and the crack is a gap: the faces at x = 1 and
+  // the faces hex 0 shared with hex 2 (two of their nodes split), from both sides.
+  for (int v : {1, 2, 5, 6}) {
+    m.points.push_back(m.points[m.hexes[0][v]]);
+    m.hexes[0][v] = m.point_count() - 1;
   }
   const MeshCheckReport r = mesh_check(m);
+  EXPECT_EQ(r.bodies, 1);
   EXPECT_EQ(r.duplicate_nodes, 4);
-  EXPECT_EQ(r.non_conformal_faces, 2);
+  EXPECT_EQ(r.non_conformal_faces, 4);
   EXPECT_EQ(r.hanging_nodes, 0);  // coincident corners are duplicates, not T-junctions
   EXPECT_FALSE(r.conformal);
+  // Cut right through (a row of two hexes, hex 1 with its own nodes on x = 1) the mesh falls
+  // into two bodies glued face on face: an interface, not a defect.
+  HexMesh cut = fixture_brick(2, 1, 1);
+  for (int v : {0, 3, 4, 7}) {
+    cut.points.push_back(cut.points[cut.hexes[1][v]]);
+    cut.hexes[1][v] = cut.point_count() - 1;
+  }
+  const MeshCheckReport c = mesh_check(cut);
+  EXPECT_EQ(c.bodies, 2);
+  EXPECT_EQ(c.interface_faces, 1);
+  EXPECT_EQ(c.interface_nodes, 4);
+  EXPECT_EQ(c.duplicate_nodes, 0);
+  EXPECT_EQ(c.non_conformal_faces, 0);
+  EXPECT_TRUE(c.valid());
 }
 
 TEST(Conformity, RefusesBadIds) {

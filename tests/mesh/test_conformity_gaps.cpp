@@ -1,6 +1,8 @@
 /// The checker on valid meshes nobody on this project shaped, and on the gaps it must still find
 /// (mesh/conformity.hpp, "Without a reference"): every real mesh of ../shared/meshes passes
-/// except the two that are not valid, a cracked copy of each fails, T-junctions, self-contact, a
+/// except the two that are not valid (those of several bodies with their bodies and interfaces
+/// counted), a cracked copy of each fails, two bricks with unmerged nodes are two bodies and a
+/// crack inside one still fails, T-junctions, self-contact, a
 /// strongly warped face beside its neighbour (the former false alarm) and faces of a warped input
 /// quad whose nodes slid on it.
 
@@ -101,6 +103,21 @@ TEST(ConformityGaps, EveryValidSharedMeshPassesAndACrackedCopyFails) {
   // nodes sit at the midpoint of a boundary edge, 122 boundary edges lie in four boundary
   // faces: counted independently by matching sorted face node sets).
   const std::set<std::string> invalid = {"sphere_projected_inverted.mesh", "bunny_voxel.mesh"};
+  // The meshes of several bodies (parts glued or in contact along coincident faces whose nodes
+  // are not merged): bodies, interface face pairs, interface nodes and self-contact faces,
+  // measured. peridigm's 8 bodies are glued face on face (29 pairs, 58 faces: the "58
+  // non-conformal faces" the checker reported before bodies), and 12 faces of its ring touch
+  // another body with no node on a node (contact). exomerge's 5 blocks are a unit cube cut into
+  // parts meshed apart and glued with non-matching faces (a small face on a big one: 400 pairs,
+  // formerly 650 non-conformal faces and 610 hanging nodes). The beam and sphere of MFEM's
+  // contact mesh touch at 3 nodes only. Every other mesh is one body with no interface.
+  struct Bodies {
+    int64_t bodies, interface_faces, interface_nodes, self_contact_faces;
+  };
+  const std::map<std::string, Bodies> several_bodies = {
+      {"exo_peridigm_contact_ring.e", {8, 29, 342, 12}},
+      {"exo_seacas_exomerge_results.e", {5, 400, 144, 0}},
+      {"mfem_beam_sphere.mesh", {3, 0, 3, 0}}};
   const std::vector<std::string> names = shared_mesh_files();
   ASSERT_GE(names.size(), 13u);
   int cracked = 0;
@@ -112,8 +129,13 @@ TEST(ConformityGaps, EveryValidSharedMeshPassesAndACrackedCopyFails) {
     if (invalid.count(name)) continue;
     EXPECT_EQ(r.non_conformal_faces, 0);
     EXPECT_EQ(r.hanging_nodes, 0);
-    EXPECT_EQ(r.self_contact_faces, 0);
     EXPECT_EQ(r.duplicate_nodes, 0);
+    const auto found = several_bodies.find(name);
+    const Bodies expected = found != several_bodies.end() ? found->second : Bodies{1, 0, 0, 0};
+    EXPECT_EQ(r.self_contact_faces, expected.self_contact_faces);
+    EXPECT_EQ(r.bodies, expected.bodies);
+    EXPECT_EQ(r.interface_faces, expected.interface_faces);
+    EXPECT_EQ(r.interface_nodes, expected.interface_nodes);
     // The same mesh against itself as the reference (what a refinement of nothing gives).
     EXPECT_TRUE(mesh_check(mesh, &mesh).valid());
 
@@ -125,9 +147,13 @@ TEST(ConformityGaps, EveryValidSharedMeshPassesAndACrackedCopyFails) {
     // neighbours: five coincident pairs, each joined by a split node.
     EXPECT_EQ(c.non_conformal_faces, 10);
     EXPECT_EQ(c.hanging_nodes, 0);
-    EXPECT_EQ(c.self_contact_faces, 0);
+    EXPECT_EQ(c.self_contact_faces, r.self_contact_faces);
     EXPECT_EQ(c.duplicate_nodes, 4);
     EXPECT_EQ(c.boundary_faces, r.boundary_faces + 10);
+    // The cracked hex keeps its other four nodes, so its body and the interfaces are unchanged.
+    EXPECT_EQ(c.bodies, r.bodies);
+    EXPECT_EQ(c.interface_faces, r.interface_faces);
+    EXPECT_EQ(c.interface_nodes, r.interface_nodes);
     EXPECT_FALSE(c.conformal);
     EXPECT_FALSE(c.valid());
     // Against the uncracked mesh as the reference the ten faces are off its boundary too.
@@ -135,6 +161,71 @@ TEST(ConformityGaps, EveryValidSharedMeshPassesAndACrackedCopyFails) {
     ++cracked;
   }
   EXPECT_GE(cracked, 9);
+}
+
+/// `a` and `b` in one mesh, `b`'s node ids after `a`'s: nothing merged.
+HexMesh mesh_side_by_side(const HexMesh& a, const HexMesh& b) {
+  HexMesh m = a;
+  const int32_t offset = a.point_count();
+  m.points.insert(m.points.end(), b.points.begin(), b.points.end());
+  for (HexCell c : b.hexes) {
+    for (int32_t& v : c) v += offset;
+    m.hexes.push_back(c);
+  }
+  return m;
+}
+
+TEST(ConformityGaps, TwoBricksWithUnmergedNodesAreTwoBodiesAndAGapInsideOneStillFails) {
+  // Two 2 x 2 x 2 bricks of unit hexes side by side along x, each with its own nodes: the shared
+  // plane x = 2 holds 4 coincident face pairs and 9 coincident node pairs.
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> left, right;
+  box_split(left, Eigen::Vector3d(0, 0, 0), 2, 2);
+  box_split(right, Eigen::Vector3d(2, 0, 0), 2, 2);
+  const HexMesh bricks = mesh_side_by_side(mesh_from_boxes(left), mesh_from_boxes(right));
+  ASSERT_EQ(bricks.point_count(), 54);
+  const MeshCheckReport r = mesh_check(bricks, nullptr, 2);
+  EXPECT_EQ(r.bodies, 2);
+  EXPECT_EQ(r.interface_faces, 4);
+  EXPECT_EQ(r.interface_nodes, 9);
+  EXPECT_EQ(r.non_conformal_faces, 0);
+  EXPECT_EQ(r.duplicate_nodes, 0);
+  EXPECT_EQ(r.hanging_nodes, 0);
+  EXPECT_EQ(r.self_contact_faces, 0);
+  EXPECT_EQ(r.boundary_faces, 2 * 24);
+  EXPECT_TRUE(r.valid());
+  const nlohmann::json j = r;
+  EXPECT_EQ(j["bodies"], 2);
+  EXPECT_EQ(j["interface_faces"], 4);
+  EXPECT_EQ(j["interface_nodes"], 9);
+  // Against itself as the reference the interface faces lie on the reference's boundary.
+  EXPECT_TRUE(mesh_check(bricks, &bricks).valid());
+
+  // The same bricks merged into one: one body, no interface.
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> both = left;
+  both.insert(both.end(), right.begin(), right.end());
+  const MeshCheckReport merged = mesh_check(mesh_from_boxes(both));
+  EXPECT_EQ(merged.bodies, 1);
+  EXPECT_EQ(merged.interface_faces, 0);
+  EXPECT_EQ(merged.interface_nodes, 0);
+  EXPECT_TRUE(merged.valid());
+
+  // A crack inside the left brick: hex 0 gets its own copies of its +x face's nodes. It still
+  // shares its other four nodes with its neighbours, so it stays in the left body, and the crack
+  // is a gap as in a mesh of one body; the interface is unchanged.
+  const HexMesh cracked = mesh_cracked(bricks, 0, 1);
+  const MeshCheckReport c = mesh_check(cracked, nullptr, 2);
+  EXPECT_EQ(c.bodies, 2);
+  EXPECT_EQ(c.interface_faces, 4);
+  EXPECT_EQ(c.interface_nodes, 9);
+  // The crack face and the faces hex 0 shared with hexes 2 (+y) and 4 (+z), from both sides.
+  EXPECT_EQ(c.non_conformal_faces, 6);
+  EXPECT_EQ(c.duplicate_nodes, 4);
+  EXPECT_FALSE(c.valid());
+  // The same crack in the merged bricks gives the same defect counts.
+  const MeshCheckReport m = mesh_check(mesh_cracked(mesh_from_boxes(both), 0, 1), nullptr, 2);
+  EXPECT_EQ(m.non_conformal_faces, c.non_conformal_faces);
+  EXPECT_EQ(m.duplicate_nodes, 4);
+  EXPECT_FALSE(m.valid());
 }
 
 TEST(ConformityGaps, UnusedVerticesNeverMakeAMeshInvalid) {
@@ -250,12 +341,18 @@ TEST(ConformityGaps, SelfContactIsReportedAndNoDefect) {
   EXPECT_EQ(g.non_conformal_faces, 2);
   EXPECT_EQ(g.hanging_nodes, 3);  // (2,1,1) and (1,2,1) on the box face's edges, (1,1,1) inside
   EXPECT_FALSE(g.valid());
-  // With nodes of its own at the same place: the corner node is split, a crack.
+  // With nodes of its own at the same place the cube shares no node with the box: two bodies
+  // glued at a corner on a corner (a non-matching interface, as where parts meshed apart are
+  // glued), which is valid; the crack a split corner node would be inside one body is tested by
+  // the cracked meshes above.
   const MeshCheckReport s = mesh_check(mesh_from_boxes(corner, {true, false}));
-  EXPECT_EQ(s.non_conformal_faces, 2);
-  EXPECT_EQ(s.duplicate_nodes, 1);
-  EXPECT_EQ(s.hanging_nodes, 3);
-  EXPECT_FALSE(s.valid());
+  EXPECT_EQ(s.bodies, 2);
+  EXPECT_EQ(s.interface_faces, 1);
+  EXPECT_EQ(s.interface_nodes, 1);
+  EXPECT_EQ(s.non_conformal_faces, 0);
+  EXPECT_EQ(s.duplicate_nodes, 0);
+  EXPECT_EQ(s.hanging_nodes, 0);
+  EXPECT_TRUE(s.valid());
 }
 
 /// Trilinear map of hex `h` of `mesh` from the unit cube.

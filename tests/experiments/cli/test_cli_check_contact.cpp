@@ -1,5 +1,5 @@
 /// `hexrefine check` names self-contact (mesh/conformity.hpp): a note, exit 0; a gap stays a
-/// defect, exit 1.
+/// defect, exit 1; several bodies in contact are named with their interfaces, exit 0.
 
 #include <gtest/gtest.h>
 
@@ -31,7 +31,7 @@ HexMesh box_with_cube(double x0, double y0) {
   return m;
 }
 
-TEST(CliCheckContact, SelfContactIsANoteAndASplitCornerIsAGap) {
+TEST(CliCheckContact, SelfContactIsANoteAndASplitCornerIsAGapInOneBody) {
   const auto dir = test_temp_dir("cli_check_contact");
   const std::string contact = (dir / "contact.mesh").string();
   const std::string crack = (dir / "crack.mesh").string();
@@ -46,10 +46,49 @@ TEST(CliCheckContact, SelfContactIsANoteAndASplitCornerIsAGap) {
       << a.output;
   std::ifstream in(report);
   EXPECT_EQ(nlohmann::json::parse(in)["self_contact_faces"], 2);
+  // The two hexes share no node: two bodies glued corner on corner, named, exit 0.
   const CliRun b = cli_run("check " + crack);
-  EXPECT_EQ(b.exit_code, 1) << b.output;
-  EXPECT_NE(b.output.find("2 non-conformal faces"), std::string::npos) << b.output;
-  EXPECT_NE(b.output.find("1 duplicate nodes"), std::string::npos) << b.output;
+  EXPECT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_NE(b.output.find("2 bodies, 1 interface face pairs, 1 interface nodes"), std::string::npos)
+      << b.output;
+  // The cube's corner (2, 2, 1) made the box's node: one body, and the small face on the big one
+  // is a T-junction pocket, a gap (the cube's own copy of the node stays, unused: 1 duplicate).
+  HexMesh joined = box_with_cube(1, 1);
+  joined.hexes[1][2] = joined.hexes[0][6];
+  const std::string pocket = (dir / "pocket.mesh").string();
+  mesh_write(pocket, joined);
+  const CliRun c = cli_run("check " + pocket);
+  EXPECT_EQ(c.exit_code, 1) << c.output;
+  EXPECT_NE(c.output.find("2 non-conformal faces"), std::string::npos) << c.output;
+  EXPECT_NE(c.output.find("1 duplicate nodes"), std::string::npos) << c.output;
+  EXPECT_EQ(c.output.find(" bodies, "), std::string::npos) << c.output;
+}
+
+TEST(CliCheckContact, BodiesInContactAreNamedAndValid) {
+  // MFEM's beam-sphere contact mesh: three bodies touching along coincident faces whose nodes
+  // are not merged (../shared/meshes/README.md); counts measured.
+  const auto dir = test_temp_dir("cli_check_bodies");
+  const auto report = dir / "r.json";
+  const CliRun run =
+      cli_run("check " + shared_mesh("mfem_beam_sphere.mesh") + " --report " + report.string());
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("3 bodies, 0 interface face pairs, 3 interface nodes"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("valid: conformal"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("INVALID"), std::string::npos) << run.output;
+  std::ifstream in(report);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["bodies"], 3);
+  EXPECT_EQ(j["interface_faces"], 0);  // they touch at 3 nodes only
+  EXPECT_EQ(j["interface_nodes"], 3);
+  EXPECT_EQ(j["non_conformal_faces"], 0);
+  EXPECT_EQ(j["duplicate_nodes"], 0);
+  EXPECT_EQ(j["valid"], true);
+  // A mesh of one body names no bodies.
+  const CliRun one = cli_run("check " + shared_mesh("sphere_conforming.mesh"));
+  EXPECT_EQ(one.exit_code, 0) << one.output;
+  EXPECT_EQ(one.output.find(" bodies, "), std::string::npos) << one.output;
 }
 
 }  // namespace

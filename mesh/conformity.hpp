@@ -78,7 +78,8 @@
 ///   were (a crack's split faces and nodes: its cracked hex still shares the nodes of its other
 ///   faces with its neighbours, so it stays in the body).
 /// - duplicate node: a node within 1e-12 x (bounding-box diagonal) of a node with a lower id of
-///   the same body (see body).
+///   the same body (see body; an unused node counts as of every body, so near a used node it is
+///   a duplicate, as in a mesh of one body).
 /// - unused node: a node no hex refers to.
 /// - self-contact face: see "Without a reference" above (not examined with a reference, whose
 ///   boundary the output's is compared with instead).

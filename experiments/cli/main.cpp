@@ -1,5 +1,5 @@
-#include "experiments/cli/cli.hpp"
 #include "experiments/bench/process_huge_pages.hpp"
+#include "experiments/cli/cli.hpp"
 
 int main(int argc, char** argv) {
   hexrefine::process_prefer_huge_pages(argv);

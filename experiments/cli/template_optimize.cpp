@@ -408,9 +408,9 @@ double adjustment_case_min(TemplateReferenceTable& table, const TemplateLibrary&
   return min;
 }
 
-/// Step 2, the table's rows of the standard templates at table.rules: each template's exact minimum,
-/// its movable nodes optimised at the rule (standard_at_rule) and their minimum, its own rule
-/// the shared one (rule_bounds_find replaces it where a rule of its own does better).
+/// Step 2, the table's rows of the standard templates at table.rules: each template's exact
+/// minimum, its movable nodes optimised at the rule (standard_at_rule) and their minimum, its own
+/// rule the shared one (rule_bounds_find replaces it where a rule of its own does better).
 void table_templates_fill(TemplateReferenceTable& table, double max_edge_ratio) {
   table.templates.clear();
   for (TemplateTag tag : template_standard_tags) {

@@ -1,8 +1,8 @@
 /// \file
 /// `hexrefine bench --instructions` and `hexrefine bench-compare --gate instructions`
-/// (experiments/cli/cli_bench_instructions.cpp, experiments/cli/cli_bench_gate.cpp): the gate's verdicts
-/// and exit codes, malformed files, the committed baseline (every workload, with its identity),
-/// and a real run of a few workloads under Callgrind, twice (the counts repeat).
+/// (experiments/cli/cli_bench_instructions.cpp, experiments/cli/cli_bench_gate.cpp): the gate's
+/// verdicts and exit codes, malformed files, the committed baseline (every workload, with its
+/// identity), and a real run of a few workloads under Callgrind, twice (the counts repeat).
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 /// \file
-/// experiments/cli/cli_output.hpp and the size guard of `hexrefine refine`: an output that cannot be
-/// written (unknown extension, missing folder, a folder in its place) is refused with exit 2
+/// experiments/cli/cli_output.hpp and the size guard of `hexrefine refine`: an output that cannot
+/// be written (unknown extension, missing folder, a folder in its place) is refused with exit 2
 /// before the input is read, by refine, smooth, convert and generate; a refinement whose size
 /// bound (hexes x 27^passes) exceeds --max-hexes (default 2^31 - 1) is refused with exit 1
 /// before refining. Nothing is written in any refusal.

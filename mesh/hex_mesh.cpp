@@ -26,6 +26,80 @@ std::vector<int32_t>& mesh_attribute(HexMesh& mesh, std::string_view name, int32
   return mesh.attributes.back().values;
 }
 
+std::string_view mesh_block_name(const HexMesh& mesh, int32_t id) {
+  for (const BlockName& b : mesh.block_names)
+    if (b.id == id) return b.name;
+  return {};
+}
+
+const MeshField* mesh_find_field(const HexMesh& mesh, std::string_view name,
+                                 FieldLocation location) {
+  for (const MeshField& f : mesh.fields)
+    if (f.name == name && f.location == location) return &f;
+  return nullptr;
+}
+
+namespace {
+std::string set_label(const char* kind, int64_t id, const std::string& name) {
+  std::string s = std::string(kind) + " " + std::to_string(id);
+  if (!name.empty()) s += " '" + name + "'";
+  return s;
+}
+
+/// Throws InputError for the first inconsistent side set, node set or field of `mesh`.
+void mesh_validate_annotations(const HexMesh& mesh, const std::string& what) {
+  const int64_t hexes = mesh.hex_count(), nodes = mesh.point_count();
+  for (const SideSet& s : mesh.side_sets) {
+    if (s.hexes.size() != s.faces.size())
+      throw InputError(what + ": " + side_set_label(s) + " has " + std::to_string(s.hexes.size()) +
+                       " hexes for " + std::to_string(s.faces.size()) + " faces");
+    for (size_t k = 0; k < s.hexes.size(); ++k) {
+      if (s.hexes[k] < 0 || s.hexes[k] >= hexes)
+        throw InputError(what + ": " + side_set_label(s) + ": entry " + std::to_string(k) +
+                         " names hex " + std::to_string(s.hexes[k]) + ", expected 0.." +
+                         std::to_string(hexes - 1));
+      if (s.faces[k] < 0 || s.faces[k] > 5)
+        throw InputError(what + ": " + side_set_label(s) + ": entry " + std::to_string(k) +
+                         " names face " + std::to_string(s.faces[k]) + " of hex " +
+                         std::to_string(s.hexes[k]) + ", expected 0..5");
+    }
+  }
+  for (const NodeSet& s : mesh.node_sets) {
+    for (size_t k = 0; k < s.nodes.size(); ++k)
+      if (s.nodes[k] < 0 || s.nodes[k] >= nodes)
+        throw InputError(what + ": " + node_set_label(s) + ": entry " + std::to_string(k) +
+                         " names node " + std::to_string(s.nodes[k]) + ", expected 0.." +
+                         std::to_string(nodes - 1));
+    if (!s.distribution_factors.empty() && s.distribution_factors.size() != s.nodes.size())
+      throw InputError(what + ": " + node_set_label(s) + " has " +
+                       std::to_string(s.distribution_factors.size()) +
+                       " distribution factors for " + std::to_string(s.nodes.size()) + " nodes");
+  }
+  for (const MeshField& f : mesh.fields) {
+    const bool on_nodes = f.location == FieldLocation::node;
+    const int64_t count = on_nodes ? nodes : hexes;
+    if (f.components < 1 ||
+        static_cast<int64_t>(f.values.size()) != count * static_cast<int64_t>(f.components))
+      throw InputError(what + ": " + (on_nodes ? "nodal" : "element") + " field '" + f.name +
+                       "' has " + std::to_string(f.values.size()) + " values, expected " +
+                       std::to_string(count) + " " + (on_nodes ? "nodes" : "hexes") + " x " +
+                       std::to_string(f.components) + " components");
+  }
+}
+}  // namespace
+
+std::string side_set_label(const SideSet& set) {
+  return set_label("side set", set.id, set.name);
+}
+std::string node_set_label(const NodeSet& set) {
+  return set_label("node set", set.id, set.name);
+}
+
+bool mesh_has_annotations(const HexMesh& mesh) {
+  return !mesh.block_names.empty() || !mesh.side_sets.empty() || !mesh.node_sets.empty() ||
+         !mesh.fields.empty() || !mesh.title.empty();
+}
+
 void mesh_validate_ids(const HexMesh& mesh, const std::string& what, int threads) {
   const int64_t n = static_cast<int64_t>(mesh.points.size());
   // Per chunk of hexes; the first chunk's error is the one rethrown, so the message names the
@@ -57,6 +131,7 @@ void mesh_validate_ids(const HexMesh& mesh, const std::string& what, int threads
       throw InputError(what + ": attribute '" + a.name + "' has " +
                        std::to_string(a.values.size()) + " values for " +
                        std::to_string(mesh.hexes.size()) + " hexes");
+  mesh_validate_annotations(mesh, what);
 }
 
 Eigen::Vector3d hex_centroid(const HexMesh& mesh, int32_t h) {

@@ -341,7 +341,49 @@ HexMesh mesh_read_from_memory(const std::string& name, std::string_view bytes) {
   return mesh;
 }
 
-void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOptions& options) {
+MeshFormatHolds mesh_format_holds(MeshFormat format) {
+  // What each writer writes today; a writer that learns to write more updates its row.
+  switch (format) {
+    case MeshFormat::medit:
+      return {};
+    case MeshFormat::vtk_legacy:
+    case MeshFormat::vtu:
+      return {};
+    case MeshFormat::gmsh:
+      return {};
+    case MeshFormat::exodus:
+      return {};
+    case MeshFormat::abaqus:
+      return {};
+  }
+  return {};
+}
+
+std::vector<std::string> mesh_format_drops(const HexMesh& mesh, MeshFormat format) {
+  const MeshFormatHolds holds = mesh_format_holds(format);
+  std::vector<std::string> dropped;
+  if (!holds.block_names)
+    for (const BlockName& b : mesh.block_names)
+      dropped.push_back("name '" + b.name + "' of block " + std::to_string(b.id));
+  if (!holds.side_sets)
+    for (const SideSet& s : mesh.side_sets) dropped.push_back(side_set_label(s));
+  for (const NodeSet& s : mesh.node_sets) {
+    if (!holds.node_sets)
+      dropped.push_back(node_set_label(s));
+    else if (!holds.node_set_distribution_factors && !s.distribution_factors.empty())
+      dropped.push_back("distribution factors of " + node_set_label(s));
+  }
+  for (const MeshField& f : mesh.fields) {
+    const bool on_nodes = f.location == FieldLocation::node;
+    if (on_nodes ? !holds.node_fields : !holds.hex_fields)
+      dropped.push_back(std::string(on_nodes ? "nodal" : "element") + " field '" + f.name + "'");
+  }
+  if (!holds.title && !mesh.title.empty()) dropped.push_back("title '" + mesh.title + "'");
+  return dropped;
+}
+
+std::vector<std::string> mesh_write(const std::string& path, const HexMesh& mesh,
+                                    const MeshWriteOptions& options) {
   const MeshFormat format = mesh_format_of(path);
   mesh_validate_ids(mesh, "mesh to write to " + path);
   for (size_t i = 0; i < mesh.points.size(); ++i)
@@ -357,19 +399,25 @@ void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOpt
   }
   switch (format) {
     case MeshFormat::medit:
-      return io_detail::medit_write(path, mesh);
+      io_detail::medit_write(path, mesh);
+      break;
     case MeshFormat::vtk_legacy:
-      return io_detail::vtk_write(path, mesh, options.binary, options.cell_scalars);
+      io_detail::vtk_write(path, mesh, options.binary, options.cell_scalars);
+      break;
     case MeshFormat::vtu:
-      return io_detail::vtu_write(path, mesh, options.cell_scalars, options.ascii,
-                                  options.compress);
+      io_detail::vtu_write(path, mesh, options.cell_scalars, options.ascii, options.compress);
+      break;
     case MeshFormat::gmsh:
-      return io_detail::gmsh_write(path, mesh, options.binary, options.cell_scalars);
+      io_detail::gmsh_write(path, mesh, options.binary, options.cell_scalars);
+      break;
     case MeshFormat::exodus:
-      return io_detail::exodus_write(path, mesh, options.cell_scalars);
+      io_detail::exodus_write(path, mesh, options.cell_scalars);
+      break;
     case MeshFormat::abaqus:
-      return io_detail::abaqus_write(path, mesh);
+      io_detail::abaqus_write(path, mesh);
+      break;
   }
+  return mesh_format_drops(mesh, format);
 }
 
 }  // namespace hexrefine

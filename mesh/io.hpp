@@ -71,6 +71,13 @@ struct MeshReadOptions {
   /// off: `hexrefine check`, whose checker counts non-manifold faces (matching the faces of an
   /// 11.4 M-hex mesh twice cost a second).
   bool manifold_test = true;
+  /// Which time step's fields to read where a format holds several (Exodus; Gmsh data blocks
+  /// with a time step): 0 the last, K >= 1 the K-th (Exodus' numbering). A step the file does not
+  /// have is an InputError naming the steps it has.
+  int64_t time_step = 0;
+  /// When set, receives one line per thing the file holds that the mesh cannot carry (e.g.
+  /// "global variable 'energy'", "239 info records"): the caller warns and reports them.
+  std::vector<std::string>* dropped = nullptr;
 };
 
 /// Reads a hex mesh; the format follows from the extension. Throws InputError
@@ -87,10 +94,30 @@ void mesh_require_manifold(const HexMesh& mesh, const std::string& path);
 /// are written to a temporary file in the system temp folder, read and removed.
 HexMesh mesh_read_from_memory(const std::string& name, std::string_view bytes);
 
+/// What each format can hold of a mesh's annotations (HexMesh): one row per format in io.cpp,
+/// from which mesh_write names what it drops.
+struct MeshFormatHolds {
+  bool block_names = false;
+  bool side_sets = false;
+  bool node_sets = false;
+  bool node_fields = false;
+  bool hex_fields = false;
+  bool node_set_distribution_factors = false;
+  bool title = false;
+};
+MeshFormatHolds mesh_format_holds(MeshFormat format);
+
+/// What writing `mesh` in `format` leaves out, one line each ("side set 1 'inlet'", "nodal field
+/// 'temperature'", "title"), in the order of the mesh's lists; empty when the format holds all.
+std::vector<std::string> mesh_format_drops(const HexMesh& mesh, MeshFormat format);
+
 /// Writes `mesh` atomically (temporary file + rename). Throws InputError for a mesh the format
 /// cannot hold (e.g. a bad attribute name), OperationError if the file cannot be written.
 /// ASCII formats print each double in the shortest decimal form that reads back as the same
 /// double (std::to_chars), so coordinates read back exactly.
-void mesh_write(const std::string& path, const HexMesh& mesh, const MeshWriteOptions& options = {});
+/// @return what the format could not hold (mesh_format_drops): the caller warns and reports it,
+///   so nothing is dropped silently.
+std::vector<std::string> mesh_write(const std::string& path, const HexMesh& mesh,
+                                    const MeshWriteOptions& options = {});
 
 }  // namespace hexrefine
